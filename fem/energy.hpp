@@ -1,0 +1,35 @@
+#pragma once
+// The energy balance of an explicit run. Works of forces are integrated with the trapezoidal
+// rule over displacement increments; because the central-difference scheme is staggered, the
+// half of a step that lies beyond t^n is held as `pending` until the next cycle, so every number
+// reported at t^n covers exactly [0, t^n].
+namespace ncfsim::fem {
+
+struct WorkAccumulator {
+  double committed = 0, pending = 0;
+  /// Force F^n with displacement increments before (du_old) and after (du_new) t^n, as dot
+  /// products F.du_old and F.du_new.
+  void add(double f_dot_du_old, double f_dot_du_new) {
+    committed += pending + 0.5 * f_dot_du_old;
+    pending = 0.5 * f_dot_du_new;
+  }
+};
+
+struct EnergyBalance {
+  double time = 0;
+  double kinetic = 0;
+  double internal = 0;       // stress work of all elements, incl. physical stabilisation
+  double stabilisation = 0;  // part of internal carried by the hex stabilisation
+  double hourglass = 0;      // viscous (non-physical) hourglass work
+  double contact = 0;        // interface energy: penalty stored + friction dissipated
+  double friction = 0;       // part of contact dissipated by friction
+  double damping = 0;        // dissipated by mass damping
+  double external_work = 0;  // applied loads, gravity, supports, tools
+  double initial_total = 0;  // kinetic + internal at t = 0
+
+  double total() const { return kinetic + internal + hourglass + contact + damping; }
+  /// |E - E0 - W_ext| over the largest energy in play.
+  double error() const;
+};
+
+}  // namespace ncfsim::fem

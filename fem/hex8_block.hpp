@@ -1,0 +1,71 @@
+#pragma once
+// One-point hexahedra of one part and one material, state held as structure of arrays.
+//
+// Formulation (see docs/theory.md):
+//  * uniform-gradient (Flanagan-Belytschko) B operator, b_I = dV/dx_I / V, exact volume, so the
+//    patch test holds on distorted meshes;
+//  * co-rotational hypoelastic stress update: the element frame follows the element's xi/eta
+//    edges (Gram-Schmidt), the material axes are fixed in that frame, so fibre axes convect with
+//    the element;
+//  * physically based, assumed-strain hourglass stabilisation in the element frame: each
+//    hourglass mode is resisted by the energy of its linear (bending) or bilinear strain field,
+//    with the parasitic shear of bending removed (Belytschko-Bindeman type). One element through
+//    a thin layer then bends with the right stiffness. A small viscous part damps hourglass
+//    noise; only that part is non-physical and is reported as hourglass energy.
+#include <cstdint>
+#include <vector>
+
+#include "fem/material.hpp"
+
+namespace ncfsim::fem {
+
+struct Hex8Block {
+  int part = 0;
+  const SolidMaterial* material = nullptr;  // borrowed, outlives the block
+  std::size_t n = 0;
+  std::vector<std::int32_t> conn;      // [8][n] node indices
+  std::vector<std::int64_t> user_id;   // [n]
+  std::vector<double> stress;          // [6][n] Cauchy stress in the material frame
+  std::vector<double> strain;          // [6][n] accumulated (logarithmic) strain, material frame
+  std::vector<double> history;         // [n_history][n]
+  std::vector<double> hg_force;        // [12][n] hourglass generalised forces, element frame, [3*mode+axis]
+  std::vector<double> mat_axes;        // [9][n] material axes in the element frame (row-major, axes = columns)
+  std::vector<double> hg_moduli;       // [6][n] E1 E2 E3 G12 G23 G13 along the element axes
+  std::vector<double> volume;          // [n] current volume
+  std::vector<double> density;         // [n] density incl. mass scaling
+  double hourglass_stiffness = 1.0;    // scale of the physical stabilisation (1 = exact bending)
+  double hourglass_viscosity = 0.05;   // fraction of critical damping on the hourglass modes
+  double p_modulus = 0.0;              // material's largest dilatational modulus
+};
+
+struct ElementEnergyIncrement {
+  double internal = 0;       // stress power incl. physical stabilisation
+  double stabilisation = 0;  // part of `internal` carried by the stabilisation
+  double hourglass = 0;      // viscous (non-physical) hourglass work
+};
+
+struct StableStep {
+  double dt = 1e300;
+  std::int64_t element = -1;  // user id of the controlling element
+  bool is_bar = false;
+};
+
+/// Sets up a block from reference coordinates: volumes, frames, hourglass moduli, density.
+/// `material_axes_global` (row-major, axes as columns) gives the material axes in the reference
+/// configuration. Throws NumericalError naming the element if a volume is not positive.
+void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& material_axes_global);
+
+/// Element nodal masses (rho V / 8) added into `mass` [3*n_nodes].
+void hex8_lumped_mass(const Hex8Block& b, double* mass);
+
+/// Stable time step of every element (characteristic length V/A_max over wave speed).
+StableStep hex8_stable_step(const Hex8Block& b, const double* x);
+void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt);
+
+/// Internal forces at positions x with velocities v (that moved the nodes over the last step dt):
+/// updates stress and hourglass state, subtracts internal forces from f [3*n_nodes], accumulates
+/// energy increments and the stable step. Throws NumericalError on a negative or NaN volume.
+void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double dt, double* f,
+                          ElementEnergyIncrement& energy, StableStep& step);
+
+}  // namespace ncfsim::fem

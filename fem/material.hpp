@@ -1,0 +1,79 @@
+#pragma once
+// The solid material interface. A material is called once per batch of elements (never per
+// element): it receives strain increments in the material frame and updates stresses and
+// history in place. Voigt order 11, 22, 33, 12, 23, 13 with engineering shear strains.
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <string>
+
+namespace ncfsim::fem {
+
+using Voigt6x6 = std::array<double, 36>;  // row-major
+
+struct MaterialBatch {
+  std::size_t n = 0;             // elements in the batch
+  std::size_t stride = 0;        // distance between components of stress and history
+  std::size_t strain_stride = 0; // distance between components of strain_increment
+  const double* strain_increment = nullptr;  // [6][strain_stride], material frame, borrowed
+  double* stress = nullptr;      // [6][stride], material frame, updated in place
+  double* history = nullptr;     // [n_history][stride], updated in place
+  double dt = 0.0;
+};
+
+class SolidMaterial {
+ public:
+  virtual ~SolidMaterial() = default;
+  virtual const std::string& name() const = 0;
+  virtual double density() const = 0;
+  /// Largest dilatational modulus (rho c^2) the law can reach: sets the stable time step.
+  virtual double p_wave_modulus() const = 0;
+  /// Initial elastic stiffness in the material frame (used for the hourglass stabilisation).
+  virtual Voigt6x6 elastic_stiffness() const = 0;
+  virtual int n_history() const { return 0; }
+  virtual void update_stress(const MaterialBatch& batch) const = 0;
+};
+
+/// Hooke's law, isotropic.
+class ElasticIsotropic final : public SolidMaterial {
+ public:
+  ElasticIsotropic(std::string name, double density, double youngs_modulus, double poisson_ratio);
+  const std::string& name() const override { return name_; }
+  double density() const override { return rho_; }
+  double p_wave_modulus() const override { return lambda_ + 2 * mu_; }
+  Voigt6x6 elastic_stiffness() const override;
+  void update_stress(const MaterialBatch& b) const override;
+
+ private:
+  std::string name_;
+  double rho_, lambda_, mu_;
+};
+
+struct OrthotropicConstants {
+  double E1, E2, E3, nu12, nu13, nu23, G12, G13, G23;
+};
+
+/// Orthotropic Hooke's law in the convected material frame.
+class ElasticOrthotropic final : public SolidMaterial {
+ public:
+  ElasticOrthotropic(std::string name, double density, const OrthotropicConstants& c);
+  const std::string& name() const override { return name_; }
+  double density() const override { return rho_; }
+  double p_wave_modulus() const override;
+  Voigt6x6 elastic_stiffness() const override { return C_; }
+  void update_stress(const MaterialBatch& b) const override;
+
+ private:
+  std::string name_;
+  double rho_;
+  Voigt6x6 C_{};
+};
+
+/// Stiffness from engineering constants; throws std::invalid_argument if not positive definite.
+Voigt6x6 orthotropic_stiffness(const OrthotropicConstants& c);
+
+/// Uniaxial moduli E1..E3 and shear moduli G12, G23, G13 seen along the axes of a frame whose
+/// axes, expressed in the material frame, are the columns of `axes` (row-major 3x3).
+std::array<double, 6> directional_moduli(const Voigt6x6& C, const std::array<double, 9>& axes);
+
+}  // namespace ncfsim::fem

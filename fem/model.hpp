@@ -1,0 +1,80 @@
+#pragma once
+// Everything the explicit solver needs, checked before the time loop starts: mesh, materials,
+// part properties, constraints, loads, tools and time controls. Node lists refer to the mesh's
+// (renumbered) node indices.
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fem/bar_block.hpp"
+#include "fem/material.hpp"
+#include "fem/mesh.hpp"
+#include "fem/rigid_tool.hpp"
+#include "fem/vec3.hpp"
+
+namespace ncfsim::fem {
+
+constexpr std::array<double, 9> kIdentityAxes{1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+struct PartProperties {
+  enum class Kind { Solid, Bar } kind = Kind::Solid;
+  int material = -1;  // index into Model::materials (solids)
+  int bar_law = -1;   // index into Model::bar_laws (bars)
+  std::array<double, 9> material_axes = kIdentityAxes;  // row-major, axes as columns, global
+  double hourglass_stiffness = 1.0;
+  double hourglass_viscosity = 0.05;
+};
+
+struct FixedDofs {
+  std::string name;
+  std::vector<std::int32_t> nodes;
+  std::array<bool, 3> dofs{true, true, true};
+};
+
+struct PrescribedVelocity {
+  std::string name;
+  std::vector<std::int32_t> nodes;
+  std::array<bool, 3> dofs{false, false, false};  // which components are prescribed
+  V3 velocity;                                     // value after the ramp
+  double ramp_time = 0;                            // smooth ramp from 0
+};
+
+struct NodalLoad {
+  std::string name;
+  std::vector<std::int32_t> nodes;
+  V3 force_per_node;   // N on each node after the ramp
+  double ramp_time = 0;
+};
+
+struct InitialVelocity {
+  std::vector<std::int32_t> nodes;
+  V3 velocity;
+};
+
+struct TimeControl {
+  double end_time = 0;
+  double safety_factor = 0.9;
+  double mass_scaling_dt = 0;       // 0: off; else elements below this step get added mass
+  double history_interval = 0;      // 0: 200 rows over the run
+  double frame_interval = 0;        // 0: 20 frames over the run
+  std::int64_t max_cycles = 0;      // 0: unlimited
+  double energy_balance_limit = 0.05;
+};
+
+struct Model {
+  Mesh mesh;
+  std::vector<std::unique_ptr<SolidMaterial>> materials;
+  std::vector<BarForceLaw> bar_laws;
+  std::vector<PartProperties> parts;  // indexed like mesh.part_names
+  std::vector<FixedDofs> fixed;
+  std::vector<PrescribedVelocity> velocities;
+  std::vector<NodalLoad> loads;
+  std::vector<InitialVelocity> initial_velocities;
+  V3 gravity;
+  double mass_damping = 0;  // mass-proportional damping coefficient alpha (1/s)
+  std::vector<RigidTool> tools;
+  TimeControl time;
+};
+
+}  // namespace ncfsim::fem

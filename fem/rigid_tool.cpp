@@ -1,0 +1,244 @@
+#include "fem/rigid_tool.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <vtkCellArray.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkSTLReader.h>
+#include <vtkTriangleFilter.h>
+
+namespace ncfsim::fem {
+
+namespace {
+
+// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+V3 closest_on_triangle(const V3& p, const V3& a, const V3& b, const V3& c) {
+  const V3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const V3 bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const V3 cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  return a + (vb * denom) * ab + (vc * denom) * ac;
+}
+
+}  // namespace
+
+TriangleSurface::TriangleSurface(std::vector<std::array<V3, 3>> triangles) : tri_(std::move(triangles)) {
+  if (tri_.empty()) throw std::invalid_argument("triangulated surface has no triangles");
+  const double big = std::numeric_limits<double>::max();
+  lo_ = {big, big, big};
+  hi_ = {-big, -big, -big};
+  double edge_sum = 0;
+  normal_.reserve(tri_.size());
+  for (const auto& t : tri_) {
+    for (const auto& p : t) {
+      lo_ = {std::min(lo_.x, p.x), std::min(lo_.y, p.y), std::min(lo_.z, p.z)};
+      hi_ = {std::max(hi_.x, p.x), std::max(hi_.y, p.y), std::max(hi_.z, p.z)};
+    }
+    edge_sum += norm(t[1] - t[0]) + norm(t[2] - t[1]) + norm(t[0] - t[2]);
+    normal_.push_back(normalized(cross(t[1] - t[0], t[2] - t[0])));
+  }
+  cell_ = std::max(edge_sum / (3.0 * static_cast<double>(tri_.size())), 1e-12);
+  const V3 span = hi_ - lo_;
+  auto cells = [&](double s) { return std::max(1, static_cast<int>(std::ceil(s / cell_))); };
+  while (static_cast<double>(cells(span.x)) * cells(span.y) * cells(span.z) > 4e6) cell_ *= 2;
+  dims_ = {cells(span.x), cells(span.y), cells(span.z)};
+  const std::size_t n_cells = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
+  std::vector<std::vector<std::int32_t>> bins(n_cells);
+  auto idx = [&](double v, double l, int d) {
+    return std::clamp(static_cast<int>((v - l) / cell_), 0, d - 1);
+  };
+  for (std::size_t t = 0; t < tri_.size(); ++t) {
+    V3 a = tri_[t][0], b = a;
+    for (const auto& p : tri_[t]) {
+      a = {std::min(a.x, p.x), std::min(a.y, p.y), std::min(a.z, p.z)};
+      b = {std::max(b.x, p.x), std::max(b.y, p.y), std::max(b.z, p.z)};
+    }
+    for (int k = idx(a.z, lo_.z, dims_[2]); k <= idx(b.z, lo_.z, dims_[2]); ++k)
+      for (int j = idx(a.y, lo_.y, dims_[1]); j <= idx(b.y, lo_.y, dims_[1]); ++j)
+        for (int i = idx(a.x, lo_.x, dims_[0]); i <= idx(b.x, lo_.x, dims_[0]); ++i)
+          bins[static_cast<std::size_t>(i + dims_[0] * (j + dims_[1] * k))].push_back(
+              static_cast<std::int32_t>(t));
+  }
+  start_.assign(n_cells + 1, 0);
+  for (std::size_t c = 0; c < n_cells; ++c) start_[c + 1] = start_[c] + static_cast<std::int32_t>(bins[c].size());
+  items_.reserve(static_cast<std::size_t>(start_.back()));
+  for (auto& b : bins) items_.insert(items_.end(), b.begin(), b.end());
+}
+
+TriangleSurface TriangleSurface::read_stl(const std::string& path, double scale) {
+  vtkNew<vtkSTLReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  vtkNew<vtkTriangleFilter> tri;
+  tri->SetInputConnection(reader->GetOutputPort());
+  tri->Update();
+  vtkPolyData* pd = tri->GetOutput();
+  if (!pd || pd->GetNumberOfPolys() == 0)
+    throw std::invalid_argument("could not read triangles from STL file '" + path + "'");
+  std::vector<std::array<V3, 3>> tris;
+  tris.reserve(static_cast<std::size_t>(pd->GetNumberOfPolys()));
+  vtkCellArray* polys = pd->GetPolys();
+  polys->InitTraversal();
+  vtkIdType npts = 0;
+  const vtkIdType* pts = nullptr;
+  while (polys->GetNextCell(npts, pts)) {
+    if (npts != 3) continue;
+    std::array<V3, 3> t;
+    for (int k = 0; k < 3; ++k) {
+      double p[3];
+      pd->GetPoint(pts[k], p);
+      t[k] = {scale * p[0], scale * p[1], scale * p[2]};
+    }
+    tris.push_back(t);
+  }
+  return TriangleSurface(std::move(tris));
+}
+
+bool TriangleSurface::closest(const V3& p, double radius, double& gap, V3& normal) const {
+  if (p.x < lo_.x - radius || p.y < lo_.y - radius || p.z < lo_.z - radius ||
+      p.x > hi_.x + radius || p.y > hi_.y + radius || p.z > hi_.z + radius)
+    return false;
+  auto idx = [&](double v, double l, int d) {
+    return std::clamp(static_cast<int>((v - l) / cell_), 0, d - 1);
+  };
+  double best = radius * radius;
+  std::int32_t best_t = -1;
+  V3 best_q;
+  for (int k = idx(p.z - radius, lo_.z, dims_[2]); k <= idx(p.z + radius, lo_.z, dims_[2]); ++k)
+    for (int j = idx(p.y - radius, lo_.y, dims_[1]); j <= idx(p.y + radius, lo_.y, dims_[1]); ++j)
+      for (int i = idx(p.x - radius, lo_.x, dims_[0]); i <= idx(p.x + radius, lo_.x, dims_[0]); ++i) {
+        const std::size_t c = static_cast<std::size_t>(i + dims_[0] * (j + dims_[1] * k));
+        for (std::int32_t s = start_[c]; s < start_[c + 1]; ++s) {
+          const auto t = static_cast<std::size_t>(items_[static_cast<std::size_t>(s)]);
+          const V3 q = closest_on_triangle(p, tri_[t][0], tri_[t][1], tri_[t][2]);
+          const V3 d = p - q;
+          const double d2 = dot(d, d);
+          if (d2 < best) best = d2, best_t = static_cast<std::int32_t>(t), best_q = q;
+        }
+      }
+  if (best_t < 0) return false;
+  const V3 n = normal_[static_cast<std::size_t>(best_t)];
+  const V3 d = p - best_q;
+  const double dist = std::sqrt(best);
+  const double side = dot(d, n) >= 0 ? 1.0 : -1.0;
+  gap = side * dist;
+  normal = dist > 1e-14 * (1 + norm(p)) ? (side / dist) * d : n;
+  return true;
+}
+
+bool RigidSurface::gap_at(const V3& p, double& gap, V3& normal) const {
+  const V3 r = p - point;
+  switch (shape) {
+    case ToolShape::Plane:
+      gap = dot(r, axis);
+      normal = axis;
+      return true;
+    case ToolShape::PlaneWithHole: {
+      const double h = dot(r, axis);
+      const V3 radial = r - h * axis;
+      if (dot(radial, radial) < radius * radius) return false;
+      gap = h;
+      normal = axis;
+      return true;
+    }
+    case ToolShape::Sphere: {
+      const double d = norm(r);
+      if (d == 0) return false;
+      gap = body_inside ? radius - d : d - radius;
+      normal = (body_inside ? -1.0 / d : 1.0 / d) * r;
+      return true;
+    }
+    case ToolShape::Cylinder: {
+      const V3 radial = r - dot(r, axis) * axis;
+      const double d = norm(radial);
+      if (d == 0) return false;
+      gap = body_inside ? radius - d : d - radius;
+      normal = (body_inside ? -1.0 / d : 1.0 / d) * radial;
+      return true;
+    }
+    case ToolShape::Torus: {
+      const V3 radial = r - dot(r, axis) * axis;
+      const double rho = norm(radial);
+      if (rho == 0) return false;
+      const V3 ring = point + (radius / rho) * radial;
+      const V3 d = p - ring;
+      const double dn = norm(d);
+      if (dn == 0) return false;
+      gap = body_inside ? minor_radius - dn : dn - minor_radius;
+      normal = (body_inside ? -1.0 / dn : 1.0 / dn) * d;
+      return true;
+    }
+    case ToolShape::Triangles:
+      return triangles->closest(p, search_radius, gap, normal);
+  }
+  return false;
+}
+
+V3 tool_prescribed_velocity(const RigidTool& tool, double t) {
+  if (tool.motion.kind != ToolMotion::Kind::Velocity) return {};
+  return smooth_ramp(t, tool.motion.ramp_time) * tool.motion.velocity;
+}
+
+void tool_contact_forces(RigidTool& tool, const double* x, const double* v, const double* mass,
+                         double dt, double* fc) {
+  const std::size_t n = tool.contact_nodes.size();
+  if (tool.tangential.size() != 3 * n) tool.tangential.assign(3 * n, 0.0);
+  const double inv_dt2 = 1.0 / (dt * dt);
+  V3 ftool{};
+  std::int64_t active = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    const auto i = static_cast<std::size_t>(tool.contact_nodes[s]);
+    const V3 p = V3::at(x + 3 * i) - tool.displacement;
+    double gap = 0;
+    V3 nrm;
+    V3* ft = reinterpret_cast<V3*>(&tool.tangential[3 * s]);
+    if (!tool.surface.gap_at(p, gap, nrm) || gap - tool.thickness >= 0) {
+      *ft = {};
+      continue;
+    }
+    ++active;
+    const double k = tool.penalty_scale * mass[3 * i] * inv_dt2;
+    const double fn = -k * (gap - tool.thickness);
+    V3 F = fn * nrm;
+    if (tool.friction > 0) {
+      const V3 vrel = V3::at(v + 3 * i) - tool.velocity;
+      const V3 vt = vrel - dot(vrel, nrm) * nrm;
+      V3 trial = *ft - dot(*ft, nrm) * nrm;
+      trial -= (k * dt) * vt;
+      const double cap = tool.friction * fn, mag = norm(trial);
+      if (mag > cap) {
+        tool.friction_dissipation += cap * (mag - cap) / k;
+        trial = (cap / mag) * trial;
+      }
+      *ft = trial;
+      F += trial;
+    } else {
+      *ft = {};
+    }
+    fc[3 * i] += F.x;
+    fc[3 * i + 1] += F.y;
+    fc[3 * i + 2] += F.z;
+    ftool -= F;
+  }
+  tool.force = ftool;
+  tool.n_active = active;
+}
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,94 @@
+#pragma once
+// Rigid tools: analytic surfaces (plane, sphere, cylinder, torus, plane with a circular hole) and
+// triangulated surfaces from STL, moving in translation with a prescribed velocity or driven by a
+// prescribed force along an axis (a blankholder), in node-to-rigid penalty contact with Coulomb
+// friction (regularised stick: an elastic tangential spring capped at mu * normal force).
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fem/vec3.hpp"
+
+namespace ncfsim::fem {
+
+enum class ToolShape { Plane, Sphere, Cylinder, Torus, PlaneWithHole, Triangles };
+
+/// Closest-point queries on triangles, bucketed on a uniform grid.
+class TriangleSurface {
+ public:
+  explicit TriangleSurface(std::vector<std::array<V3, 3>> triangles);
+  static TriangleSurface read_stl(const std::string& path, double scale);
+  /// Signed distance along the nearest triangle's normal; false when nothing within `radius`.
+  bool closest(const V3& p, double radius, double& gap, V3& normal) const;
+  std::size_t size() const { return tri_.size(); }
+  const std::vector<std::array<V3, 3>>& triangles() const { return tri_; }
+
+ private:
+  std::vector<std::array<V3, 3>> tri_;
+  std::vector<V3> normal_;
+  V3 lo_, hi_;
+  double cell_ = 1;
+  std::array<int, 3> dims_{1, 1, 1};
+  std::vector<std::int32_t> start_, items_;  // CSR buckets
+};
+
+struct RigidSurface {
+  ToolShape shape = ToolShape::Plane;
+  V3 point;          // plane point, sphere/torus centre, axis point
+  V3 axis{0, 0, 1};  // plane normal or axis (unit); the body lies on the side it points to
+  double radius = 0;       // sphere, cylinder, torus major radius, hole radius
+  double minor_radius = 0; // torus tube radius
+  bool body_inside = false;  // sphere/cylinder/torus: the body is inside the surface
+  std::shared_ptr<const TriangleSurface> triangles;
+  double search_radius = 0;  // triangles: how far to look for the nearest face
+
+  /// Gap (positive = apart) and outward unit normal at a point in the tool's own frame.
+  bool gap_at(const V3& p, double& gap, V3& normal) const;
+};
+
+struct ToolMotion {
+  enum class Kind { Fixed, Velocity, Force } kind = Kind::Fixed;
+  V3 velocity;             // Velocity: target velocity after the ramp
+  double ramp_time = 0;    // smooth (C1) ramp from rest
+  V3 axis{0, 0, 1};        // Force: direction of the applied force and of the free motion
+  double force = 0;        // Force: magnitude (N), applied along `axis`
+  double mass = 0;         // Force: tool mass (kg)
+};
+
+struct RigidTool {
+  std::string name;
+  RigidSurface surface;
+  ToolMotion motion;
+  std::vector<std::int32_t> contact_nodes;  // slave nodes
+  double friction = 0;        // Coulomb coefficient
+  double penalty_scale = 0.1; // k = scale * m_node / dt^2: never lowers the stable step
+  double thickness = 0;       // contact offset (shell thickness / 2 or clearance)
+
+  // State
+  V3 displacement;                  // tool translation at the current time
+  V3 velocity;                      // tool velocity over the current half step
+  V3 force;                         // resultant contact force exerted BY the nodes ON the tool
+  std::vector<double> tangential;   // [3*n_contact_nodes] elastic friction forces
+  double friction_dissipation = 0;  // J
+  std::int64_t n_active = 0;
+};
+
+/// Smooth ramp from 0 to 1 over [0, t_ramp] (cubic, zero slope at both ends).
+inline double smooth_ramp(double t, double t_ramp) {
+  if (t_ramp <= 0 || t >= t_ramp) return t < 0 ? 0.0 : 1.0;
+  if (t <= 0) return 0.0;
+  const double s = t / t_ramp;
+  return s * s * (3 - 2 * s);
+}
+
+/// Prescribed tool velocity at time t (Velocity kind).
+V3 tool_prescribed_velocity(const RigidTool& tool, double t);
+
+/// Contact forces of one tool at positions x, velocities v (last half step) and step dt;
+/// adds the forces on the nodes into f_contact [3*n_nodes] and updates the tool's state.
+void tool_contact_forces(RigidTool& tool, const double* x, const double* v, const double* mass,
+                         double dt, double* f_contact);
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,389 @@
+#include "fem/solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "fem/errors.hpp"
+
+namespace ncfsim::fem {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+}  // namespace
+
+ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
+  Mesh& mesh = model_.mesh;
+  mesh.fill_default_user_ids();
+  try {
+    mesh.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", "mesh", e.what());
+  }
+  if (mesh.n_nodes() == 0 || (mesh.hexes.empty() && mesh.bars.empty()))
+    throw InputError("", "mesh", "the model has no elements");
+  if (model_.parts.size() != mesh.part_names.size())
+    throw InputError("", "parts", "every mesh part needs properties");
+  if (!(model_.time.end_time > 0)) throw InputError("", "time.end_time", "must be > 0");
+  if (!(model_.time.safety_factor > 0 && model_.time.safety_factor <= 1))
+    throw InputError("", "time.safety_factor", "must be in (0, 1]");
+
+  const std::size_t n = mesh.n_nodes();
+  for (NodalVector* vec : {&x0, &x, &v, &mass, &f_int, &f_ext, &f_contact, &f_damp, &reaction})
+    *vec = NodalVector(n);
+  {
+    auto X0 = x0.view();
+    auto X = x.view();
+    std::copy(mesh.coords.begin(), mesh.coords.end(), X0.data());
+    std::copy(mesh.coords.begin(), mesh.coords.end(), X.data());
+  }
+  build_blocks();
+  if (model_.time.mass_scaling_dt > 0) apply_mass_scaling();
+  assemble_mass();
+
+  fixed_mask_.assign(3 * n, 0);
+  for (const auto& fx : model_.fixed)
+    for (auto node : fx.nodes)
+      for (int c = 0; c < 3; ++c)
+        if (fx.dofs[c]) fixed_mask_[3 * static_cast<std::size_t>(node) + c] = 1;
+  for (std::size_t k = 0; k < model_.velocities.size(); ++k) {
+    const auto& pv = model_.velocities[k];
+    for (auto node : pv.nodes)
+      for (int c = 0; c < 3; ++c)
+        if (pv.dofs[c]) fixed_mask_[3 * static_cast<std::size_t>(node) + c] = static_cast<std::uint8_t>(2 + k);
+  }
+  if (model_.velocities.size() > 250)
+    throw InputError("", "boundary.velocity", "at most 250 prescribed-velocity sets");
+
+  {
+    auto V = v.view();
+    for (const auto& iv : model_.initial_velocities)
+      for (auto node : iv.nodes) {
+        const auto i = static_cast<std::size_t>(node);
+        V[3 * i] = iv.velocity.x, V[3 * i + 1] = iv.velocity.y, V[3 * i + 2] = iv.velocity.z;
+      }
+    for (std::size_t d = 0; d < 3 * n; ++d)
+      if (fixed_mask_[d] == 1) V[d] = 0;
+    auto M = mass.view();
+    double ke = 0;
+    for (std::size_t d = 0; d < 3 * n; ++d) ke += 0.5 * M[d] * V[d] * V[d];
+    energy_.initial_total = ke;
+    energy_.kinetic = ke;
+  }
+
+  StableStep s;
+  {
+    auto X = x.view();
+    for (const auto& b : hex_) {
+      auto sb = hex8_stable_step(b, X.data());
+      if (sb.dt < s.dt) s = sb;
+    }
+    for (const auto& b : bar_)
+      for (std::size_t e = 0; e < b.n; ++e)
+        if (b.dt_crit[e] < s.dt) s = {b.dt_crit[e], b.user_id[e], true};
+  }
+  step_ = s;
+  dt_ = model_.time.safety_factor * s.dt;
+
+  for (auto& tool : model_.tools) {
+    if (tool.motion.kind == ToolMotion::Kind::Force && !(tool.motion.mass > 0))
+      throw InputError("", "tool." + tool.name + ".mass", "a force-driven tool needs a mass > 0");
+    for (auto node : tool.contact_nodes)
+      if (node < 0 || static_cast<std::size_t>(node) >= n)
+        throw InputError("", "tool." + tool.name, "contact node outside the mesh");
+    tool.tangential.assign(3 * tool.contact_nodes.size(), 0.0);
+    tool.displacement = {};
+    tool.velocity = tool_prescribed_velocity(tool, 0.5 * dt_);
+  }
+}
+
+std::size_t ExplicitSolver::n_hexes() const {
+  std::size_t s = 0;
+  for (const auto& b : hex_) s += b.n;
+  return s;
+}
+
+std::size_t ExplicitSolver::n_bars() const {
+  std::size_t s = 0;
+  for (const auto& b : bar_) s += b.n;
+  return s;
+}
+
+void ExplicitSolver::build_blocks() {
+  const Mesh& mesh = model_.mesh;
+  auto X = x.view();
+  for (std::size_t p = 0; p < model_.parts.size(); ++p) {
+    const PartProperties& pp = model_.parts[p];
+    const std::string& pname = mesh.part_names[p];
+    std::vector<std::size_t> hexes, bars;
+    for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
+      if (mesh.hex_part[e] == static_cast<int>(p)) hexes.push_back(e);
+    for (std::size_t e = 0; e < mesh.bars.size(); ++e)
+      if (mesh.bar_part[e] == static_cast<int>(p)) bars.push_back(e);
+    if (pp.kind == PartProperties::Kind::Solid) {
+      if (!bars.empty()) throw InputError("", "part." + pname, "a solid part holds bar elements");
+      if (hexes.empty()) continue;
+      if (pp.material < 0 || static_cast<std::size_t>(pp.material) >= model_.materials.size())
+        throw InputError("", "part." + pname + ".material", "no such material");
+      Hex8Block b;
+      b.part = static_cast<int>(p);
+      b.material = model_.materials[static_cast<std::size_t>(pp.material)].get();
+      b.n = hexes.size();
+      b.conn.resize(8 * b.n);
+      b.user_id.resize(b.n);
+      for (std::size_t j = 0; j < b.n; ++j) {
+        for (int I = 0; I < 8; ++I) b.conn[I * b.n + j] = mesh.hexes[hexes[j]][I];
+        b.user_id[j] = mesh.hex_user_id[hexes[j]];
+      }
+      b.hourglass_stiffness = pp.hourglass_stiffness;
+      b.hourglass_viscosity = pp.hourglass_viscosity;
+      hex8_initialise(b, X.data(), pp.material_axes);
+      hex_.push_back(std::move(b));
+    } else {
+      if (!hexes.empty()) throw InputError("", "part." + pname, "a bar part holds hexahedra");
+      if (bars.empty()) continue;
+      if (pp.bar_law < 0 || static_cast<std::size_t>(pp.bar_law) >= model_.bar_laws.size())
+        throw InputError("", "part." + pname + ".bar_law", "no such bar law");
+      BarBlock b;
+      b.part = static_cast<int>(p);
+      b.law = &model_.bar_laws[static_cast<std::size_t>(pp.bar_law)];
+      b.n = bars.size();
+      b.conn.resize(2 * b.n);
+      b.user_id.resize(b.n);
+      for (std::size_t j = 0; j < b.n; ++j) {
+        b.conn[j] = mesh.bars[bars[j]][0];
+        b.conn[b.n + j] = mesh.bars[bars[j]][1];
+        b.user_id[j] = mesh.bar_user_id[bars[j]];
+      }
+      bar_initialise(b, X.data());
+      bar_.push_back(std::move(b));
+    }
+  }
+}
+
+void ExplicitSolver::apply_mass_scaling() {
+  const double target = model_.time.mass_scaling_dt, sf = model_.time.safety_factor;
+  auto X = x.view();
+  std::vector<double> dt;
+  for (auto& b : hex_) {
+    hex8_element_steps(b, X.data(), dt);
+    for (std::size_t e = 0; e < b.n; ++e)
+      if (sf * dt[e] < target) b.density[e] *= std::pow(target / (sf * dt[e]), 2);
+  }
+  for (auto& b : bar_) {
+    for (std::size_t e = 0; e < b.n; ++e)
+      if (sf * b.dt_crit[e] < target) b.mass_scale[e] = std::pow(target / (sf * b.dt_crit[e]), 2);
+    bar_initialise(b, X.data());
+  }
+}
+
+void ExplicitSolver::assemble_mass() {
+  mass.set(0.0);
+  {
+    auto M = mass.view();
+    for (const auto& b : hex_) hex8_lumped_mass(b, M.data());
+    for (const auto& b : bar_) bar_lumped_mass(b, M.data());
+    const std::size_t n = model_.mesh.n_nodes();
+    for (std::size_t i = 0; i < n; ++i)
+      if (!(M[3 * i] > 0)) {
+        const auto p = model_.mesh.node(i);
+        std::ostringstream os;
+        os << "node " << model_.mesh.node_user_id[i] << " at (" << p[0] << ", " << p[1] << ", "
+           << p[2] << ") belongs to no element and has no mass";
+        throw InputError("", "mesh", os.str());
+      }
+  }
+  part_mass_.assign(model_.parts.size(), {});
+  for (std::size_t p = 0; p < part_mass_.size(); ++p) part_mass_[p].part = model_.mesh.part_names[p];
+  for (const auto& b : hex_) {
+    const double rho = b.material->density();
+    for (std::size_t e = 0; e < b.n; ++e) {
+      part_mass_[static_cast<std::size_t>(b.part)].mass += rho * b.volume[e];
+      part_mass_[static_cast<std::size_t>(b.part)].added_mass += (b.density[e] - rho) * b.volume[e];
+    }
+  }
+  for (const auto& b : bar_) {
+    const double rho_l = b.law->linear_density();
+    for (std::size_t e = 0; e < b.n; ++e) {
+      part_mass_[static_cast<std::size_t>(b.part)].mass += rho_l * b.length0[e];
+      part_mass_[static_cast<std::size_t>(b.part)].added_mass +=
+          rho_l * (b.mass_scale[e] - 1.0) * b.length0[e];
+    }
+  }
+}
+
+V3 ExplicitSolver::reaction_force(const std::vector<std::int32_t>& nodes) const {
+  auto R = reaction.view();
+  V3 s;
+  for (auto node : nodes) {
+    const auto i = static_cast<std::size_t>(node);
+    s += V3{R[3 * i], R[3 * i + 1], R[3 * i + 2]};
+  }
+  return s;
+}
+
+void ExplicitSolver::check_finite(const double* vel) const {
+  const std::size_t n = model_.mesh.n_nodes();
+  auto X = x.view();
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(vel[3 * i + c])) {
+        std::ostringstream os;
+        os << "numerical instability: velocity of node " << model_.mesh.node_user_id[i] << " at ("
+           << X[3 * i] << ", " << X[3 * i + 1] << ", " << X[3 * i + 2]
+           << ") m is not finite at t = " << t_ << " s, cycle " << cycle_
+           << "; the stable step is controlled by " << (step_.is_bar ? "bar " : "hexahedron ")
+           << step_.element;
+        throw NumericalError(os.str());
+      }
+}
+
+void ExplicitSolver::step(const std::function<void()>& at_tn) {
+  const std::size_t n = model_.mesh.n_nodes(), nd = 3 * n;
+  auto t0 = Clock::now();
+  double dt_new = 0;
+  {  // views are released before the callback, which may read the vectors itself
+  auto X = x.view();
+  auto Vv = v.view();
+  auto M = mass.view();
+  auto Fi = f_int.view();
+  auto Fe = f_ext.view();
+  auto Fc = f_contact.view();
+  auto Fd = f_damp.view();
+  auto Rr = reaction.view();
+  double* fi = Fi.data();
+  for (std::size_t d = 0; d < nd; ++d) fi[d] = 0.0, Fe[d] = 0.0, Fc[d] = 0.0;
+
+  // Internal forces at x^n from v^{n-1/2}.
+  ElementEnergyIncrement inc;
+  StableStep st;
+  for (auto& b : hex_) hex8_internal_forces(b, X.data(), Vv.data(), dt_prev_, fi, inc, st);
+  for (auto& b : bar_) bar_internal_forces(b, X.data(), fi, inc, st);
+  energy_.internal += inc.internal;
+  energy_.stabilisation += inc.stabilisation;
+  energy_.hourglass += inc.hourglass;
+  step_ = st;
+  dt_new = model_.time.safety_factor * st.dt;
+  if (dt_prev_ > 0) dt_new = std::min(dt_new, 1.1 * dt_prev_);  // limit step growth
+  timers_.internal_force += seconds_since(t0);
+
+  // Contact with rigid tools at x^n.
+  t0 = Clock::now();
+  const double dt_c = dt_prev_ > 0 ? dt_prev_ : dt_new;
+  for (auto& tool : model_.tools) tool_contact_forces(tool, X.data(), Vv.data(), M.data(), dt_c, Fc.data());
+  timers_.contact += seconds_since(t0);
+
+  // External forces at t^n, damping from v^{n-1/2}.
+  t0 = Clock::now();
+  for (const auto& ld : model_.loads) {
+    const V3 F = smooth_ramp(t_, ld.ramp_time) * ld.force_per_node;
+    for (auto node : ld.nodes) {
+      const auto i = static_cast<std::size_t>(node);
+      Fe[3 * i] += F.x, Fe[3 * i + 1] += F.y, Fe[3 * i + 2] += F.z;
+    }
+  }
+  const V3 g = model_.gravity;
+  if (g.x != 0 || g.y != 0 || g.z != 0)
+    for (std::size_t i = 0; i < n; ++i)
+      Fe[3 * i] += M[3 * i] * g.x, Fe[3 * i + 1] += M[3 * i + 1] * g.y, Fe[3 * i + 2] += M[3 * i + 2] * g.z;
+  const double alpha = model_.mass_damping;
+  for (std::size_t d = 0; d < nd; ++d) Fd[d] = -alpha * M[d] * Vv[d];
+
+  // Prescribed velocities at t^{n+1/2}.
+  const double t_half = t_ + 0.5 * dt_new;
+  std::vector<V3> vpres(model_.velocities.size());
+  for (std::size_t k = 0; k < vpres.size(); ++k)
+    vpres[k] = smooth_ramp(t_half, model_.velocities[k].ramp_time) * model_.velocities[k].velocity;
+
+  // v^{n+1/2}; works of each force kind over the increments around t^n.
+  const double dt_mid = 0.5 * (dt_prev_ + dt_new);
+  double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
+  for (std::size_t d = 0; d < nd; ++d) {
+    const double vo = Vv[d];
+    const double ftot = fi[d] + Fe[d] + Fc[d] + Fd[d];
+    double vn = vo + dt_mid * ftot / M[d];
+    const std::uint8_t code = fixed_mask_[d];
+    double r = 0;
+    if (code) {
+      const double vp = code == 1 ? 0.0 : vpres[code - 2].arr()[d % 3];
+      r = dt_mid > 0 ? M[d] * (vp - vn) / dt_mid : 0.0;
+      vn = vp;
+    }
+    Rr[d] = r;
+    Vv[d] = vn;
+    const double du_old = dt_prev_ * vo, du_new = dt_new * vn;
+    ext_old += (Fe[d] + r) * du_old, ext_new += (Fe[d] + r) * du_new;
+    damp_old += Fd[d] * du_old, damp_new += Fd[d] * du_new;
+    con_old += Fc[d] * du_old, con_new += Fc[d] * du_new;
+    const double vbar = 0.5 * (vo + vn);
+    ke += 0.5 * M[d] * vbar * vbar;
+  }
+  w_ext_.add(ext_old, ext_new);
+  w_damp_.add(damp_old, damp_new);
+  w_contact_nodes_.add(con_old, con_new);
+
+  // Tools: velocity over the next half step, and their work.
+  double tool_on_nodes_old = 0, tool_on_nodes_new = 0, tool_src_old = 0, tool_src_new = 0;
+  for (auto& tool : model_.tools) {
+    const V3 vo = tool.velocity;
+    V3 vn;
+    if (tool.motion.kind == ToolMotion::Kind::Velocity) {
+      vn = tool_prescribed_velocity(tool, t_half);
+    } else if (tool.motion.kind == ToolMotion::Kind::Force) {
+      const V3 ax = tool.motion.axis;
+      const double a = (tool.motion.force + dot(tool.force, ax)) / tool.motion.mass;
+      vn = (dot(vo, ax) + dt_mid * a) * ax;
+      const V3 vbar = 0.5 * (vo + vn);
+      ke += 0.5 * tool.motion.mass * dot(vbar, vbar);
+    }
+    tool.velocity = vn;
+    // The tool pushes the nodes with -tool.force.
+    tool_on_nodes_old += -dot(tool.force, dt_prev_ * vo);
+    tool_on_nodes_new += -dot(tool.force, dt_new * vn);
+    if (tool.motion.kind == ToolMotion::Kind::Velocity) {
+      tool_src_old += -dot(tool.force, dt_prev_ * vo);
+      tool_src_new += -dot(tool.force, dt_new * vn);
+    } else if (tool.motion.kind == ToolMotion::Kind::Force) {
+      const V3 F = tool.motion.force * tool.motion.axis;
+      tool_src_old += dot(F, dt_prev_ * vo);
+      tool_src_new += dot(F, dt_new * vn);
+    }
+  }
+  w_tools_.add(tool_src_old, tool_src_new);
+  tool_work_on_nodes_.add(tool_on_nodes_old, tool_on_nodes_new);
+
+  energy_.time = t_;
+  energy_.kinetic = ke;
+  energy_.external_work = w_ext_.committed + w_tools_.committed;
+  energy_.damping = -w_damp_.committed;
+  energy_.contact = tool_work_on_nodes_.committed - w_contact_nodes_.committed;
+  double fr = 0;
+  for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
+  energy_.friction = fr;
+  if (!std::isfinite(ke)) check_finite(Vv.data());
+  timers_.update += seconds_since(t0);
+  }
+
+  if (at_tn) {
+    t0 = Clock::now();
+    at_tn();
+    timers_.output += seconds_since(t0);
+  }
+
+  // x^{n+1}
+  {
+    auto X = x.view();
+    auto Vv = v.view();
+    for (std::size_t d = 0; d < nd; ++d) X[d] += dt_new * Vv[d];
+  }
+  for (auto& tool : model_.tools) tool.displacement += dt_new * tool.velocity;
+  t_ += dt_new;
+  dt_prev_ = dt_new;
+  dt_ = dt_new;
+  ++cycle_;
+}
+
+}  // namespace ncfsim::fem

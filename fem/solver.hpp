@@ -1,0 +1,80 @@
+#pragma once
+// Central-difference explicit time integration with a variable stable step, on nodal state held
+// in PETSc vectors. The model is checked and all element groups built before the first cycle;
+// the cycle itself only computes.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fem/bar_block.hpp"
+#include "fem/energy.hpp"
+#include "fem/hex8_block.hpp"
+#include "fem/model.hpp"
+#include "fem/petsc_vector.hpp"
+
+namespace ncfsim::fem {
+
+struct PartMassReport {
+  std::string part;
+  double mass = 0;        // physical mass, kg
+  double added_mass = 0;  // mass added by mass scaling, kg
+};
+
+struct PhaseTimers {
+  double internal_force = 0, contact = 0, update = 0, output = 0;  // seconds
+};
+
+class ExplicitSolver {
+ public:
+  /// Builds element groups, masses and the initial state. Throws InputError / NumericalError.
+  explicit ExplicitSolver(Model& model);
+
+  /// One cycle. `at_tn` (may be empty) is called once state at t^n is complete (forces,
+  /// energies, v^{n+1/2}), before the positions move on to t^{n+1}.
+  void step(const std::function<void()>& at_tn = {});
+
+  double time() const { return t_; }
+  double time_step() const { return dt_; }
+  std::int64_t cycle() const { return cycle_; }
+  const EnergyBalance& energy() const { return energy_; }
+  const StableStep& controlling_element() const { return step_; }
+  const std::vector<PartMassReport>& part_masses() const { return part_mass_; }
+  const PhaseTimers& timers() const { return timers_; }
+  std::size_t n_hexes() const;
+  std::size_t n_bars() const;
+
+  Model& model() { return model_; }
+  const Model& model() const { return model_; }
+  std::vector<Hex8Block>& hex_blocks() { return hex_; }
+  std::vector<BarBlock>& bar_blocks() { return bar_; }
+  const std::vector<Hex8Block>& hex_blocks() const { return hex_; }
+  const std::vector<BarBlock>& bar_blocks() const { return bar_; }
+
+  // Nodal state, [3*n_nodes] each.
+  NodalVector x0, x, v, mass, f_int, f_ext, f_contact, f_damp, reaction;
+
+  /// Sum over the nodes of a DOF-wise reaction of a named constraint (fixed or velocity set).
+  V3 reaction_force(const std::vector<std::int32_t>& nodes) const;
+
+ private:
+  void build_blocks();
+  void apply_mass_scaling();
+  void assemble_mass();
+  void check_finite(const double* vel) const;
+
+  Model& model_;
+  std::vector<Hex8Block> hex_;
+  std::vector<BarBlock> bar_;
+  std::vector<PartMassReport> part_mass_;
+  std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
+  double t_ = 0, dt_ = 0, dt_prev_ = 0;
+  std::int64_t cycle_ = 0;
+  StableStep step_;
+  EnergyBalance energy_;
+  WorkAccumulator w_ext_, w_damp_, w_contact_nodes_, w_tools_, tool_work_on_nodes_;
+  PhaseTimers timers_;
+};
+
+}  // namespace ncfsim::fem
