@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
+
 #include "fem/errors.hpp"
 
 namespace ncfsim::fem {
@@ -101,6 +103,22 @@ inline void gather(const Hex8Block& b, std::size_t e, const double* x, Vec3 out[
   }
 }
 
+// Modulus that bounds the highest frequency of the uniform-strain hexahedron: for a box of
+// smallest edge h, omega_max^2 <= 4 M / (rho h^2) with M the larger of the largest eigenvalue of
+// the normal block of C and twice the largest shear modulus (Flanagan-Belytschko 1984). For an
+// isotropic solid M = 3K = E/(1-2nu), above the p-wave modulus by (1+nu)/(1-nu): the plain
+// V/A_max over the dilatational speed overestimates the critical step of a cube by ~27 % (nu=0.3).
+double uniform_strain_modulus(const Voigt6x6& C) {
+  Eigen::Matrix3d Cn;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Cn(i, j) = 0.5 * (C[6 * i + j] + C[6 * j + i]);
+  const double normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Cn, Eigen::EigenvaluesOnly)
+                            .eigenvalues()
+                            .maxCoeff();
+  const double shear = 2.0 * std::max({C[6 * 3 + 3], C[6 * 4 + 4], C[6 * 5 + 5]});
+  return std::max(normal, shear);
+}
+
 }  // namespace
 
 void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& M) {
@@ -110,10 +128,12 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
   b.history.assign(static_cast<std::size_t>(b.material->n_history()) * n, 0.0);
   b.hg_force.assign(12 * n, 0.0);
   b.mat_axes.assign(9 * n, 0.0);
+  b.jac_inv0.assign(9 * n, 0.0);
   b.hg_moduli.assign(6 * n, 0.0);
   b.volume.assign(n, 0.0);
+  b.volume0.assign(n, 0.0);
   b.density.assign(n, b.material->density());
-  b.p_modulus = b.material->p_wave_modulus();
+  b.p_modulus = uniform_strain_modulus(b.material->elastic_stiffness());
   const Voigt6x6 C = b.material->elastic_stiffness();
   std::array<double, 9> last_T{};
   std::array<double, 6> last_moduli{};
@@ -127,19 +147,23 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
     b.volume[e] = g.V;
     double R[9], l[3];
     hex_frame(g, R, l);
-    std::array<double, 9> T{};  // T = R^T M: material axes in the element frame
+    // Inverse of the centre Jacobian [a1 a2 a3]: F = J J_ref^{-1} exactly for homogeneous motion.
+    const Vec3 c0 = cross(g.a[2], g.a[3]), c1 = cross(g.a[3], g.a[1]), c2 = cross(g.a[1], g.a[2]);
+    const double detJ = dot(g.a[1], c0);
+    const double Ji[9] = {c0.x / detJ, c0.y / detJ, c0.z / detJ, c1.x / detJ, c1.y / detJ,
+                          c1.z / detJ, c2.x / detJ, c2.y / detJ, c2.z / detJ};
+    for (int k = 0; k < 9; ++k) b.jac_inv0[k * n + e] = Ji[k];
+    for (int k = 0; k < 9; ++k) b.mat_axes[k * n + e] = M[k];
+    b.volume0[e] = g.V;
+    std::array<double, 9> T{};  // element axes in the material frame: T = M^T R
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
         double s = 0;
-        for (int k = 0; k < 3; ++k) s += R[3 * k + i] * M[3 * k + j];
+        for (int k = 0; k < 3; ++k) s += M[3 * k + i] * R[3 * k + j];
         T[3 * i + j] = std::abs(s) < 1e-14 ? 0.0 : s;
       }
-    for (int k = 0; k < 9; ++k) b.mat_axes[k * n + e] = T[k];
     if (!have_last || T != last_T) {
-      std::array<double, 9> Tt{};  // element axes in the material frame (columns)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) Tt[3 * i + j] = T[3 * j + i];
-      last_moduli = directional_moduli(C, Tt);
+      last_moduli = directional_moduli(C, T);
       last_T = T;
       have_last = true;
     }
@@ -185,7 +209,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
   alignas(64) double deps[6][CH];
   alignas(64) double sig_old[6][CH];
   alignas(64) double Rm[9][CH];   // element frame (columns e1 e2 e3)
-  alignas(64) double Qm[9][CH];   // material frame = R T
+  alignas(64) double Qm[9][CH];   // F M: deformation gradient times reference material axes
   alignas(64) double Vol[CH];
   alignas(64) double Dk[7][3][CH];
   alignas(64) double Ak[4][3][CH];  // a_4..a_7
@@ -225,29 +249,29 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       for (double& l : L) l *= f8V;
       double R[9], l3[3];
       hex_frame(g, R, l3);
-      double T[9], Q[9];
-      for (int k = 0; k < 9; ++k) T[k] = b.mat_axes[k * n + e];
+      // Deformation gradient F = J J_ref^{-1}, Green-Lagrange strain in the reference material
+      // axes M: E_mat = M^T (F^T F - I) M / 2. The material sees exact increments of E_mat.
+      const double J[9] = {g.a[1].x, g.a[2].x, g.a[3].x, g.a[1].y, g.a[2].y,
+                           g.a[3].y, g.a[1].z, g.a[2].z, g.a[3].z};
+      double Fm[9], FM[9];
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
-          Q[3 * r + c] = R[3 * r] * T[c] + R[3 * r + 1] * T[3 + c] + R[3 * r + 2] * T[6 + c];
-      // D = sym(L); D_mat = Q^T D Q
-      const double D[9] = {L[0], 0.5 * (L[1] + L[3]), 0.5 * (L[2] + L[6]),
-                           0.5 * (L[1] + L[3]), L[4], 0.5 * (L[5] + L[7]),
-                           0.5 * (L[2] + L[6]), 0.5 * (L[5] + L[7]), L[8]};
-      double DQ[9];
-      for (int r = 0; r < 3; ++r)
+          Fm[3 * r + c] = J[3 * r] * b.jac_inv0[c * n + e] + J[3 * r + 1] * b.jac_inv0[(3 + c) * n + e] +
+                          J[3 * r + 2] * b.jac_inv0[(6 + c) * n + e];
+      for (int r = 0; r < 3; ++r)  // F M
         for (int c = 0; c < 3; ++c)
-          DQ[3 * r + c] = D[3 * r] * Q[c] + D[3 * r + 1] * Q[3 + c] + D[3 * r + 2] * Q[6 + c];
-      double Dm[9];
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-          Dm[3 * r + c] = Q[r] * DQ[c] + Q[3 + r] * DQ[3 + c] + Q[6 + r] * DQ[6 + c];
-      deps[0][j] = dt * Dm[0];
-      deps[1][j] = dt * Dm[4];
-      deps[2][j] = dt * Dm[8];
-      deps[3][j] = dt * 2 * Dm[1];
-      deps[4][j] = dt * 2 * Dm[5];
-      deps[5][j] = dt * 2 * Dm[2];
+          FM[3 * r + c] = Fm[3 * r] * b.mat_axes[c * n + e] + Fm[3 * r + 1] * b.mat_axes[(3 + c) * n + e] +
+                          Fm[3 * r + 2] * b.mat_axes[(6 + c) * n + e];
+      // C_mat = (FM)^T (FM)
+      const double C11 = FM[0] * FM[0] + FM[3] * FM[3] + FM[6] * FM[6];
+      const double C22 = FM[1] * FM[1] + FM[4] * FM[4] + FM[7] * FM[7];
+      const double C33 = FM[2] * FM[2] + FM[5] * FM[5] + FM[8] * FM[8];
+      const double C12 = FM[0] * FM[1] + FM[3] * FM[4] + FM[6] * FM[7];
+      const double C23 = FM[1] * FM[2] + FM[4] * FM[5] + FM[7] * FM[8];
+      const double C13 = FM[0] * FM[2] + FM[3] * FM[5] + FM[6] * FM[8];
+      const double Enew[6] = {0.5 * (C11 - 1), 0.5 * (C22 - 1), 0.5 * (C33 - 1), C12, C23, C13};
+      for (int c = 0; c < 6; ++c) deps[c][j] = Enew[c] - b.strain[c * n + e];
+      for (int k = 0; k < 9; ++k) Qm[k][j] = FM[k];
       // Hourglass rates q_alpha = vhat_{3+alpha} - L a_{3+alpha}, then into the element frame.
       for (int al = 0; al < 4; ++al) {
         const Vec3 a = g.a[4 + al];
@@ -259,7 +283,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         qdot[3 * al + 2][j] = R[2] * q.x + R[5] * q.y + R[8] * q.z;
         Ak[al][0][j] = a.x, Ak[al][1][j] = a.y, Ak[al][2][j] = a.z;
       }
-      for (int k = 0; k < 9; ++k) Rm[k][j] = R[k], Qm[k][j] = Q[k];
+      for (int k = 0; k < 9; ++k) Rm[k][j] = R[k];
       for (int k = 1; k < 7; ++k) Dk[k][0][j] = g.d[k].x, Dk[k][1][j] = g.d[k].y, Dk[k][2][j] = g.d[k].z;
       for (int k = 0; k < 3; ++k) len[k][j] = l3[k];
       Vol[j] = g.V;
@@ -290,17 +314,19 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         wint += 0.5 * (sm[c] + sig_old[c][j]) * deps[c][j];
         b.strain[c * n + e] += deps[c][j];
       }
-      e_int += V * wint;
-      // Cauchy stress in global axes: Q sm Q^T
+      e_int += b.volume0[e] * wint;
+      // Cauchy stress sigma = (FM) S (FM)^T / det F, with S the 2nd Piola-Kirchhoff stress in the
+      // material axes; det F = V / V0 with the exact volumes.
       const double Sm[9] = {sm[0], sm[3], sm[5], sm[3], sm[1], sm[4], sm[5], sm[4], sm[2]};
       double Q[9], SQt[9], sg[9];
       for (int k = 0; k < 9; ++k) Q[k] = Qm[k][j];
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
           SQt[3 * r + c] = Sm[3 * r] * Q[3 * c] + Sm[3 * r + 1] * Q[3 * c + 1] + Sm[3 * r + 2] * Q[3 * c + 2];
+      const double iJ = b.volume0[e] / V;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
-          sg[3 * r + c] = Q[3 * r] * SQt[c] + Q[3 * r + 1] * SQt[3 + c] + Q[3 * r + 2] * SQt[6 + c];
+          sg[3 * r + c] = iJ * (Q[3 * r] * SQt[c] + Q[3 * r + 1] * SQt[3 + c] + Q[3 * r + 2] * SQt[6 + c]);
 
       // Physical stabilisation: incremental generalised forces in the element frame.
       const double l1 = len[0][j], l2 = len[1][j], l3 = len[2][j];

@@ -4,9 +4,9 @@
 // Formulation (see docs/theory.md):
 //  * uniform-gradient (Flanagan-Belytschko) B operator, b_I = dV/dx_I / V, exact volume, so the
 //    patch test holds on distorted meshes;
-//  * co-rotational hypoelastic stress update: the element frame follows the element's xi/eta
-//    edges (Gram-Schmidt), the material axes are fixed in that frame, so fibre axes convect with
-//    the element;
+//  * objective total-Lagrangian stress at the centre: Green-Lagrange strain from the deformation
+//    gradient F in the reference material axes, 2nd Piola-Kirchhoff stress from the material,
+//    pushed forward to Cauchy stress; fibre axes convect with F, rotations are exact, no drift;
 //  * physically based, assumed-strain hourglass stabilisation in the element frame: each
 //    hourglass mode is resisted by the energy of its linear (bending) or bilinear strain field,
 //    with the parasitic shear of bending removed (Belytschko-Bindeman type). One element through
@@ -25,17 +25,19 @@ struct Hex8Block {
   std::size_t n = 0;
   std::vector<std::int32_t> conn;      // [8][n] node indices
   std::vector<std::int64_t> user_id;   // [n]
-  std::vector<double> stress;          // [6][n] Cauchy stress in the material frame
-  std::vector<double> strain;          // [6][n] accumulated (logarithmic) strain, material frame
+  std::vector<double> stress;          // [6][n] 2nd Piola-Kirchhoff stress, reference material axes
+  std::vector<double> strain;          // [6][n] Green-Lagrange strain, reference material axes (engineering shear)
   std::vector<double> history;         // [n_history][n]
   std::vector<double> hg_force;        // [12][n] hourglass generalised forces, element frame, [3*mode+axis]
-  std::vector<double> mat_axes;        // [9][n] material axes in the element frame (row-major, axes = columns)
+  std::vector<double> mat_axes;        // [9][n] reference material axes, global (row-major, axes = columns)
+  std::vector<double> jac_inv0;        // [9][n] inverse of the reference centre Jacobian
   std::vector<double> hg_moduli;       // [6][n] E1 E2 E3 G12 G23 G13 along the element axes
   std::vector<double> volume;          // [n] current volume
+  std::vector<double> volume0;         // [n] reference volume
   std::vector<double> density;         // [n] density incl. mass scaling
   double hourglass_stiffness = 1.0;    // scale of the physical stabilisation (1 = exact bending)
   double hourglass_viscosity = 0.05;   // fraction of critical damping on the hourglass modes
-  double p_modulus = 0.0;              // material's largest dilatational modulus
+  double p_modulus = 0.0;              // modulus of the stable-step bound (uniform-strain hex)
 };
 
 struct ElementEnergyIncrement {

@@ -1,7 +1,9 @@
 #pragma once
 // The solid material interface. A material is called once per batch of elements (never per
-// element): it receives strain increments in the material frame and updates stresses and
-// history in place. Voigt order 11, 22, 33, 12, 23, 13 with engineering shear strains.
+// element): it receives Green-Lagrange strain increments in the reference material axes (which
+// convect with the deformation gradient, so fibre directions follow the fabric) and updates the
+// 2nd Piola-Kirchhoff stress and its history in place. Voigt order 11, 22, 33, 12, 23, 13 with
+// engineering shear strains.
 #include <array>
 #include <cstddef>
 #include <memory>

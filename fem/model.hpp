@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fem/bar_block.hpp"
+#include "fem/contact_interface.hpp"
 #include "fem/material.hpp"
 #include "fem/mesh.hpp"
 #include "fem/rigid_tool.hpp"
@@ -38,6 +39,7 @@ struct PrescribedVelocity {
   std::array<bool, 3> dofs{false, false, false};  // which components are prescribed
   V3 velocity;                                     // value after the ramp
   double ramp_time = 0;                            // smooth ramp from 0
+  double start_time = 0;                           // zero before this time
 };
 
 struct NodalLoad {
@@ -60,6 +62,7 @@ struct TimeControl {
   double frame_interval = 0;        // 0: 20 frames over the run
   std::int64_t max_cycles = 0;      // 0: unlimited
   double energy_balance_limit = 0.05;
+  double min_step_ratio = 1e-4;     // stop when the step falls below this share of the initial one
 };
 
 struct Model {
@@ -74,6 +77,7 @@ struct Model {
   V3 gravity;
   double mass_damping = 0;  // mass-proportional damping coefficient alpha (1/s)
   std::vector<RigidTool> tools;
+  std::vector<std::unique_ptr<ContactAlgorithm>> contacts;  // deformable / tied contacts
   TimeControl time;
 };
 

@@ -87,6 +87,8 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   }
   step_ = s;
   dt_ = model_.time.safety_factor * s.dt;
+  if (!(dt_ > 0) || !std::isfinite(dt_))
+    throw InputError("", "mesh", "no finite stable time step (element " + std::to_string(s.element) + ")");
 
   for (auto& tool : model_.tools) {
     if (tool.motion.kind == ToolMotion::Kind::Force && !(tool.motion.mass > 0))
@@ -98,6 +100,18 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
     tool.displacement = {};
     tool.velocity = tool_prescribed_velocity(tool, 0.5 * dt_);
   }
+
+  {
+    auto X0 = x0.view();
+    auto M = mass.view();
+    ContactSetup setup{&model_.mesh, &hex_, X0.data(), M.data(), dt_};
+    for (auto& c : model_.contacts) {
+      c->initialise(setup);
+      dt_ = std::min(dt_, c->stable_step_limit());
+    }
+  }
+  dt_initial_ = dt_;
+  vpres_.resize(model_.velocities.size());
 }
 
 std::size_t ExplicitSolver::n_hexes() const {
@@ -274,6 +288,10 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   t0 = Clock::now();
   const double dt_c = dt_prev_ > 0 ? dt_prev_ : dt_new;
   for (auto& tool : model_.tools) tool_contact_forces(tool, X.data(), Vv.data(), M.data(), dt_c, Fc.data());
+  for (auto& c : model_.contacts) {
+    c->add_forces(X.data(), Vv.data(), M.data(), dt_c, Fc.data());
+    dt_new = std::min(dt_new, c->stable_step_limit());
+  }
   timers_.contact += seconds_since(t0);
 
   // External forces at t^n, damping from v^{n-1/2}.
@@ -292,11 +310,21 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   const double alpha = model_.mass_damping;
   for (std::size_t d = 0; d < nd; ++d) Fd[d] = -alpha * M[d] * Vv[d];
 
+  if (dt_new < model_.time.min_step_ratio * dt_initial_) {
+    std::ostringstream os;
+    os << "numerical instability: the stable time step fell to " << dt_new << " s ("
+       << dt_new / dt_initial_ << " of the initial " << dt_initial_ << " s) at t = " << t_
+       << " s, cycle " << cycle_ << "; controlled by " << (st.is_bar ? "bar " : "hexahedron ")
+       << st.element << " (severely distorted or inverted)";
+    throw NumericalError(os.str());
+  }
+
   // Prescribed velocities at t^{n+1/2}.
   const double t_half = t_ + 0.5 * dt_new;
-  std::vector<V3> vpres(model_.velocities.size());
+  std::vector<V3>& vpres = vpres_;
   for (std::size_t k = 0; k < vpres.size(); ++k)
-    vpres[k] = smooth_ramp(t_half, model_.velocities[k].ramp_time) * model_.velocities[k].velocity;
+    vpres[k] = smooth_ramp(t_half - model_.velocities[k].start_time, model_.velocities[k].ramp_time) *
+               model_.velocities[k].velocity;
 
   // v^{n+1/2}; works of each force kind over the increments around t^n.
   const double dt_mid = 0.5 * (dt_prev_ + dt_new);
@@ -318,8 +346,9 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     ext_old += (Fe[d] + r) * du_old, ext_new += (Fe[d] + r) * du_new;
     damp_old += Fd[d] * du_old, damp_new += Fd[d] * du_new;
     con_old += Fc[d] * du_old, con_new += Fc[d] * du_new;
-    const double vbar = 0.5 * (vo + vn);
-    ke += 0.5 * M[d] * vbar * vbar;
+    // Product form: with the trapezoidal works below, 1/2 v^{n-1/2} M v^{n+1/2} makes the
+    // discrete energy balance of central differences exact for conservative forces.
+    ke += 0.5 * M[d] * vo * vn;
   }
   w_ext_.add(ext_old, ext_new);
   w_damp_.add(damp_old, damp_new);
@@ -336,8 +365,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       const V3 ax = tool.motion.axis;
       const double a = (tool.motion.force + dot(tool.force, ax)) / tool.motion.mass;
       vn = (dot(vo, ax) + dt_mid * a) * ax;
-      const V3 vbar = 0.5 * (vo + vn);
-      ke += 0.5 * tool.motion.mass * dot(vbar, vbar);
+      ke += 0.5 * tool.motion.mass * dot(vo, vn);
     }
     tool.velocity = vn;
     // The tool pushes the nodes with -tool.force.
@@ -362,6 +390,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   energy_.contact = tool_work_on_nodes_.committed - w_contact_nodes_.committed;
   double fr = 0;
   for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
+  for (const auto& c : model_.contacts) fr += c->friction_dissipation();
   energy_.friction = fr;
   if (!std::isfinite(ke)) check_finite(Vv.data());
   timers_.update += seconds_since(t0);

@@ -1,0 +1,51 @@
+#pragma once
+// The solver's view of a deformable contact (penalty, friction, tied): one object per contact
+// definition, called once per cycle (one virtual call per cycle, never per node). Implementations
+// live in fem/contact/.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fem/vec3.hpp"
+
+namespace ncfsim::fem {
+
+struct Hex8Block;
+struct Mesh;
+
+/// What a contact may read when it is set up (after masses are assembled, before cycle 0).
+struct ContactSetup {
+  const Mesh* mesh = nullptr;
+  const std::vector<Hex8Block>* hex_blocks = nullptr;
+  const double* x0 = nullptr;    // reference positions [3*n_nodes]
+  const double* mass = nullptr;  // lumped nodal masses [3*n_nodes] (incl. mass scaling)
+  double dt = 0;                 // the initial stable step (already times the safety factor)
+};
+
+/// Force resultant of one reported pair (of contact groups) for history.csv.
+struct ContactResultant {
+  std::string name;  // e.g. "tows_ply1__tows_ply2"
+  V3 force;          // on the first group, N
+};
+
+class ContactAlgorithm {
+ public:
+  virtual ~ContactAlgorithm() = default;
+  virtual const std::string& name() const = 0;
+  /// Builds surfaces, search structures and penalties; throws InputError on bad definitions.
+  virtual void initialise(const ContactSetup& setup) = 0;
+  /// Adds contact forces at positions x (velocities v over the last half step, step dt) into
+  /// f_contact [3*n_nodes]. Forces between deformable bodies must sum to zero.
+  virtual void add_forces(const double* x, const double* v, const double* mass, double dt,
+                          double* f_contact) = 0;
+  /// Energy dissipated by friction (and failed ties) so far, J; part of the contact energy.
+  virtual double friction_dissipation() const = 0;
+  /// Resultants per reported pair, valid after add_forces.
+  virtual std::vector<ContactResultant> resultants() const { return {}; }
+  /// Largest step this contact allows (1e300 = no limit). Penalties should not need one.
+  virtual double stable_step_limit() const { return 1e300; }
+  /// Number of active contacts after the last add_forces (diagnostics).
+  virtual std::int64_t active_contacts() const { return 0; }
+};
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,140 @@
+#pragma once
+// Results writers: plain data in, files out. Serial: one process writes (gather to rank 0 first).
+//
+// XdmfResultWriter: <out_dir>/results.h5 + <out_dir>/results.xdmf (XDMF 3, opens in ParaView with
+// the "XDMF Reader"/Xdmf3 readers and in meshio/h5py). Layout of results.h5:
+//
+//   /mesh/points        float64 [n_points, 3]  reference coordinates
+//   /mesh/hex8          int64   [n_hex, 8]     node ids, VTK/Abaqus ordering
+//   /mesh/bar2          int64   [n_bar, 2]
+//   /mesh/hex_part      int32   [n_hex]        part id per hexahedron
+//   /mesh/bar_part      int32   [n_bar]
+//   /mesh/part_names    string  [n_parts]      variable-length UTF-8, indexed by part id
+//   /frames/NNNNNN                             group per frame, NNNNNN = frame index (0-based,
+//                                              6 digits); attributes time (float64), cycle (int32)
+//   /frames/NNNNNN/coordinates  float64 [n_points, 3]  current positions = points + displacement
+//   /frames/NNNNNN/displacement float64 [n_points, 3]
+//   /frames/NNNNNN/<nodal field>       float64 [n_points] or [n_points, n_components]
+//   /frames/NNNNNN/hex8/<cell field>   float64 [n_hex]    or [n_hex, n_components]
+//   /frames/NNNNNN/bar2/<cell field>   float64 [n_bar]    or [n_bar, n_components]
+//   /                   attributes format = "ncfsim-results", format_version (int32),
+//                       n_frames (int32, frames complete in the file)
+//
+// results.xdmf: Domain / Grid "results" (Collection, Temporal) / one Grid per frame (Collection,
+// Spatial, with <Time Value>) holding Uniform grids "solids" (Hexahedron) and "bars" (Polyline,
+// NodesPerElement 2); an empty block is left out. Both share the frame's coordinates (the deformed
+// geometry) and carry every nodal field; cell fields and "part_id" are split into the hex and bar
+// slices.
+//
+// Crash consistency: results.h5 is opened, written, flushed and closed inside each write_frame, so
+// between calls it is a closed, complete file that other processes may open read-only. The frame
+// enters results.xdmf only after that, and results.xdmf is replaced atomically (temp + fsync +
+// rename). A process killed between write_frame calls therefore leaves valid files holding every
+// frame written so far; one killed inside write_frame leaves results.xdmf valid without that frame
+// (results.h5 itself may be damaged in that case: HDF5 1.10 has no journal).
+//
+// VtuSeriesWriter: <out_dir>/frames/frame_NNNNN.vtu (vtkXMLUnstructuredGridWriter, appended raw
+// binary, zlib, UInt64 headers; points = current coordinates; VTK_HEXAHEDRON cells then VTK_LINE
+// cells; point data "displacement" + nodal fields; cell data "part_id" + cell fields) and
+// <out_dir>/results.pvd, a ParaView collection with one DataSet (timestep = time) per frame. Each
+// .vtu is written under a temporary name and renamed; results.pvd is replaced atomically after.
+//
+// Errors: bad input -> std::invalid_argument; HDF5/VTK/file-system failure -> std::runtime_error
+// naming the file (and HDF5 object); write_frame after close() -> std::logic_error.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ncfsim::fem::io {
+
+struct ResultMesh {
+  std::vector<double> points;          ///< reference coordinates, xyz interleaved [3*n_points]
+  std::vector<std::int64_t> hex8;      ///< 8 node ids per hexahedron (VTK/Abaqus ordering)
+  std::vector<std::int64_t> bar2;      ///< 2 node ids per bar
+  std::vector<std::int32_t> hex_part;  ///< part id per hexahedron
+  std::vector<std::int32_t> bar_part;  ///< part id per bar
+  std::vector<std::string> part_names;
+
+  std::size_t n_points() const { return points.size() / 3; }
+  std::size_t n_hex() const { return hex8.size() / 8; }
+  std::size_t n_bar() const { return bar2.size() / 2; }
+};
+
+/// A nodal field has values [n_components * n_points]; a cell field [n_components * (n_hex +
+/// n_bar)], hexes first then bars. Components are interleaved per entity. Names use only letters,
+/// digits and _ - . + ( ) [ ] (no spaces), are unique within a frame, and are not "coordinates",
+/// "displacement", "part_id", "hex8", "bar2". The set of fields may differ from frame to frame.
+struct FrameField {
+  std::string name;
+  bool on_cells = false;
+  int n_components = 1;
+  std::vector<double> values;
+};
+
+struct Frame {
+  double time = 0.0;
+  int cycle = 0;
+  std::vector<double> displacement;  ///< [3*n_points]
+  std::vector<FrameField> fields;
+};
+
+/// Throws std::invalid_argument if the mesh is inconsistent (sizes, node ids out of range,
+/// negative part ids). Part ids need not have a name.
+void validate_mesh(const ResultMesh& mesh);
+/// Throws std::invalid_argument if the frame does not fit the mesh.
+void validate_frame(const ResultMesh& mesh, const Frame& frame);
+
+class XdmfResultWriter {
+ public:
+  /// Creates out_dir if needed, replaces results.xdmf by an empty time series, then creates
+  /// results.h5 (truncating) with the mesh.
+  XdmfResultWriter(std::filesystem::path out_dir, ResultMesh mesh);
+  ~XdmfResultWriter();
+  XdmfResultWriter(const XdmfResultWriter&) = delete;
+  XdmfResultWriter& operator=(const XdmfResultWriter&) = delete;
+  XdmfResultWriter(XdmfResultWriter&&) noexcept;
+  XdmfResultWriter& operator=(XdmfResultWriter&&) noexcept;
+
+  /// Appends a frame; on return both files are complete and hold it. On a throw the files still
+  /// hold the earlier frames and a later call may retry.
+  void write_frame(const Frame& frame);
+  /// Finalises; further write_frame calls throw std::logic_error. Idempotent. Not required for
+  /// valid files (the destructor does nothing that the files depend on).
+  void close();
+
+  std::size_t frames_written() const;
+  const std::filesystem::path& h5_path() const;
+  const std::filesystem::path& xdmf_path() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+class VtuSeriesWriter {
+ public:
+  /// Creates out_dir/frames if needed and replaces results.pvd by an empty collection.
+  VtuSeriesWriter(std::filesystem::path out_dir, ResultMesh mesh);
+  ~VtuSeriesWriter();
+  VtuSeriesWriter(const VtuSeriesWriter&) = delete;
+  VtuSeriesWriter& operator=(const VtuSeriesWriter&) = delete;
+  VtuSeriesWriter(VtuSeriesWriter&&) noexcept;
+  VtuSeriesWriter& operator=(VtuSeriesWriter&&) noexcept;
+
+  /// Writes frames/frame_NNNNN.vtu (NNNNN = frame index) and rewrites results.pvd.
+  void write_frame(const Frame& frame);
+  void close();
+
+  std::size_t frames_written() const;
+  const std::filesystem::path& pvd_path() const;
+  /// Path of the .vtu of frame `index` (0-based), whether or not it has been written yet.
+  std::filesystem::path frame_path(std::size_t index) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ncfsim::fem::io

@@ -1,0 +1,367 @@
+// ncfsim::render — off-screen rendering checked by pixel statistics of the written PNGs.
+//
+// Every picture is read back with vtkPNGReader and measured; no reference images are stored.
+// The program unsets DISPLAY before any test runs, so a pass proves that no X server is involved.
+// Images are kept for a human to look at in $NCFSIM_RENDER_TEST_OUTPUT (set by CTest to
+// <build>/tests/render/render_test_output), else in the system temporary folder.
+#include "render.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
+#include <vtkSmartPointer.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+namespace fs = std::filesystem;
+using namespace ncfsim::render;
+
+namespace {
+
+const bool kDisplayUnset = [] {
+  ::unsetenv("DISPLAY");
+  ::unsetenv("WAYLAND_DISPLAY");
+  return true;
+}();
+
+fs::path output_dir()
+{
+  static const fs::path dir = [] {
+    const char* env = std::getenv("NCFSIM_RENDER_TEST_OUTPUT");
+    fs::path d = env != nullptr && *env != '\0' ? fs::path(env)
+                                                : fs::temp_directory_path() / "ncfsim_render_test";
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+struct Rgb {
+  int r, g, b;
+};
+
+// Decoded PNG, rows stored bottom-up as VTK gives them (y = 0 is the bottom row).
+struct Image {
+  int width = 0, height = 0, n_components = 0;
+  vtkSmartPointer<vtkImageData> data;
+
+  Rgb at(int x, int y) const
+  {
+    const auto* p = static_cast<const unsigned char*>(data->GetScalarPointer(x, y, 0));
+    return {p[0], p[1], p[2]};
+  }
+};
+
+Image read_png(const fs::path& path)
+{
+  vtkNew<vtkPNGReader> reader;
+  EXPECT_GT(reader->CanReadFile(path.c_str()), 0) << path; // 0 = not a PNG
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  Image img;
+  img.data = reader->GetOutput();
+  int dims[3] = {0, 0, 0};
+  img.data->GetDimensions(dims);
+  img.width = dims[0];
+  img.height = dims[1];
+  img.n_components = img.data->GetNumberOfScalarComponents();
+  return img;
+}
+
+bool is_background(const Rgb& c) { return c.r >= 250 && c.g >= 250 && c.b >= 250; }
+// A fully saturated colour-map colour: the slab's faces, lit head-on, and the colour strip.
+bool is_saturated(const Rgb& c)
+{
+  return std::max({c.r, c.g, c.b}) - std::min({c.r, c.g, c.b}) > 150;
+}
+bool is_blueish(const Rgb& c) { return c.b > 200 && c.r < 60 && c.g < 90; }
+bool is_redish(const Rgb& c) { return c.r > 200 && c.g < 60 && c.b < 60; }
+bool is_dark(const Rgb& c) { return c.r < 90 && c.g < 90 && c.b < 90; }
+bool near(const Rgb& c, const std::array<int, 3>& ref, int tol)
+{
+  return std::abs(c.r - ref[0]) <= tol && std::abs(c.g - ref[1]) <= tol &&
+         std::abs(c.b - ref[2]) <= tol;
+}
+
+// n_x x n_y x 1 hexahedra of unit size, x in [0, n_x], y in [0, n_y], z in [0, 1].
+// Cell field "temperature" [K] = x of the cell centre (linear in x, 0.5 ... n_x - 0.5);
+// point field "velocity" [m/s] = (x, y, 0).
+RenderMesh slab(int n_x, int n_y)
+{
+  RenderMesh mesh;
+  auto node = [&](int i, int j, int k) {
+    return static_cast<std::int64_t>((k * (n_y + 1) + j) * (n_x + 1) + i);
+  };
+  MeshField velocity{"velocity", "m/s", false, 3, {}};
+  for (int k = 0; k <= 1; ++k) {
+    for (int j = 0; j <= n_y; ++j) {
+      for (int i = 0; i <= n_x; ++i) {
+        mesh.points.insert(mesh.points.end(), {double(i), double(j), double(k)});
+        velocity.values.insert(velocity.values.end(), {double(i), double(j), 0.0});
+      }
+    }
+  }
+  MeshField temperature{"temperature", "K", true, 1, {}};
+  for (int j = 0; j < n_y; ++j) {
+    for (int i = 0; i < n_x; ++i) {
+      mesh.hex8.insert(mesh.hex8.end(), {node(i, j, 0), node(i + 1, j, 0), node(i + 1, j + 1, 0),
+                                         node(i, j + 1, 0), node(i, j, 1), node(i + 1, j, 1),
+                                         node(i + 1, j + 1, 1), node(i, j + 1, 1)});
+      temperature.values.push_back(i + 0.5);
+    }
+  }
+  mesh.fields = {temperature, velocity};
+  return mesh;
+}
+
+} // namespace
+
+TEST(Render, OffscreenContextIsAvailable)
+{
+  std::string why;
+  const bool ok = offscreen_rendering_available(&why);
+  ASSERT_TRUE(ok) << why;
+  EXPECT_NE(why.find("OpenGL"), std::string::npos) << why;
+  std::cout << "off-screen context: " << why << "\n";
+}
+
+// 10 x 10 x 1 slab, linear cell field in x, camera Top, 1200 x 900.
+//
+// Expected slab size, from the renderer's rules: the model viewport is [0, 0.82] x [0, 0.92] of
+// the image = 984 x 828 px; ResetCamera with a parallel projection sets the half-height of the
+// view to the radius of the bounds' sphere, r = |(10, 10, 1)| / 2 = 7.089; so the 10 x 10 top
+// face spans 828 * 10 / (2 r) = 584 px each way: 584^2 = 341,000 px = 31.6 % of the image.
+// Everything else that is not background: the colour strip (~50 x 700 px = 3.2 %), the labels
+// and the titles (~1 %). Measured on llvmpipe (Mesa 22.3.6): 35.7 % non-background, 341,056
+// saturated pixels left of the scalar bar (exactly 584^2), 34,456 blue and 34,456 red ones.
+TEST(Render, SlabTopViewPixelStatistics)
+{
+  const fs::path png = output_dir() / "slab_top.png";
+  fs::remove(png);
+  MeshFigure figure;
+  figure.field = "temperature";
+  figure.title = "10 x 10 x 1 slab, temperature linear in x";
+  figure.camera = CameraPreset::Top;
+  ASSERT_NO_THROW(render_mesh_png(slab(10, 10), figure, png));
+
+  const Image img = read_png(png);
+  ASSERT_EQ(img.width, 1200);
+  ASSERT_EQ(img.height, 900);
+  ASSERT_GE(img.n_components, 3);
+
+  const int model_right = static_cast<int>(0.82 * img.width); // scalar bar starts at 0.85
+  long n_background = 0, n_slab = 0, n_blue = 0, n_red = 0, n_dark_top = 0;
+  double blue_x = 0.0, red_x = 0.0;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const Rgb c = img.at(x, y);
+      n_background += is_background(c) ? 1 : 0;
+      if (y > 0.93 * img.height && is_dark(c)) {
+        ++n_dark_top; // the figure title
+      }
+      if (x >= model_right) {
+        continue;
+      }
+      n_slab += is_saturated(c) ? 1 : 0;
+      if (is_blueish(c)) {
+        ++n_blue;
+        blue_x += x;
+      }
+      if (is_redish(c)) {
+        ++n_red;
+        red_x += x;
+      }
+    }
+  }
+  const double n_pixels = double(img.width) * img.height;
+  const double share_foreground = 1.0 - n_background / n_pixels;
+  std::cout << "non-background share " << share_foreground << ", slab pixels " << n_slab
+            << ", blue " << n_blue << ", red " << n_red << ", title dark pixels " << n_dark_top
+            << "\n";
+
+  // Whole image: slab 31.6 % + scalar bar and text ~4 %; +-3 points covers anti-aliasing and
+  // font differences, and still fails if the camera, the viewport or the scalar bar change.
+  EXPECT_GT(share_foreground, 0.33);
+  EXPECT_LT(share_foreground, 0.39);
+
+  // The slab alone: 584^2 = 341,056 px expected; 2 % allows for edge rasterisation.
+  const double expected_slab = std::pow(0.92 * img.height * 10.0 / std::sqrt(201.0), 2);
+  EXPECT_NEAR(n_slab, expected_slab, 0.02 * expected_slab);
+
+  // Both ends of the colour map on the model itself: the x = 0..1 cell column (value 0.5, the
+  // minimum) is blue, the x = 9..10 column (9.5, the maximum) is red; one column is
+  // 58 x 584 = 34,000 px. Blue must lie left of red (the field grows with x, +x is to the right).
+  const double column = expected_slab / 10.0;
+  EXPECT_GT(n_blue, 0.7 * column);
+  EXPECT_GT(n_red, 0.7 * column);
+  ASSERT_GT(n_blue, 0);
+  ASSERT_GT(n_red, 0);
+  EXPECT_LT(blue_x / n_blue + 0.6 * std::sqrt(expected_slab), red_x / n_red);
+
+  // The title is drawn (dark text pixels in the top 7 % of the image).
+  EXPECT_GT(n_dark_top, 500);
+
+  // Written atomically: no temporary file left beside it.
+  for (const auto& entry : fs::directory_iterator(output_dir())) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos)
+        << entry.path();
+  }
+}
+
+// The other cameras, a point field (vector magnitude) and bars drawn as lines.
+TEST(Render, IsoAndFrontViewsWithBarsAndPointField)
+{
+  RenderMesh mesh = slab(6, 4);
+  // A bar lattice beside the slab, on its own nodes (x in [7, 10]).
+  const auto first = static_cast<std::int64_t>(mesh.points.size() / 3);
+  for (int i = 0; i <= 3; ++i) {
+    mesh.points.insert(mesh.points.end(), {7.0 + i, 0.0, 0.0, 7.0 + i, 4.0, 1.0});
+  }
+  for (int i = 0; i <= 3; ++i) {
+    mesh.bar2.insert(mesh.bar2.end(), {first + 2 * i, first + 2 * i + 1});
+  }
+  const std::size_t n_points = mesh.points.size() / 3;
+  for (auto& f : mesh.fields) {
+    if (f.on_cells) {
+      f.values.resize(f.values.size() + 4, 10.0); // the bars' cell values follow the hexes'
+    } else {
+      f.values.resize(n_points * 3, 5.0);
+    }
+  }
+  for (auto camera : {CameraPreset::Iso, CameraPreset::Front}) {
+    const fs::path png =
+        output_dir() / (camera == CameraPreset::Iso ? "slab_iso.png" : "slab_front.png");
+    MeshFigure figure;
+    figure.field = camera == CameraPreset::Iso ? "velocity" : "temperature";
+    figure.camera = camera;
+    figure.width = 800;
+    figure.height = 600;
+    figure.range = std::array<double, 2>{0.0, 10.0};
+    figure.title = "iso/front";
+    ASSERT_NO_THROW(render_mesh_png(mesh, figure, png));
+    const Image img = read_png(png);
+    ASSERT_EQ(img.width, 800);
+    ASSERT_EQ(img.height, 600);
+    long n_model = 0;
+    std::set<int> colours;
+    for (int y = 0; y < img.height; ++y) {
+      for (int x = 0; x < static_cast<int>(0.82 * img.width); ++x) {
+        const Rgb c = img.at(x, y);
+        if (!is_background(c)) {
+          ++n_model;
+          colours.insert((c.r << 16) | (c.g << 8) | c.b);
+        }
+      }
+    }
+    std::cout << figure.field << ": model share " << n_model / double(img.width * img.height)
+              << ", distinct colours " << colours.size() << "\n";
+    // Iso: the 6 x 4 slab and the bars fill a good part of the model viewport; Front: the 1-high
+    // slab seen edge-on is a thin band (measured 4.4 % and 2.6 % of the image).
+    EXPECT_GT(n_model, 0.01 * img.width * img.height);
+    EXPECT_GT(colours.size(), 20u) << "a field-coloured model has many colours";
+  }
+}
+
+TEST(Render, CurvePlotShowsSeriesColours)
+{
+  const fs::path png = output_dir() / "plot.png";
+  CurvePlot plot;
+  plot.title = "Bias-extension test";
+  plot.x_label = "displacement [mm]";
+  plot.y_label = "force [N]";
+  CurveSeries sim{"simulation", {}, {}, false, false};
+  CurveSeries ref{"reference", {}, {}, true, false};
+  CurveSeries exp{"experiment", {}, {}, false, true};
+  for (int i = 0; i <= 60; ++i) {
+    const double x = 0.5 * i;
+    sim.x.push_back(x);
+    sim.y.push_back(12.0 * x + 0.3 * x * x);
+    ref.x.push_back(x);
+    ref.y.push_back(10.0 * x + 0.35 * x * x);
+  }
+  for (int i = 0; i <= 10; ++i) {
+    exp.x.push_back(3.0 * i);
+    exp.y.push_back(11.0 * 3 * i + 0.32 * 9.0 * i * i);
+  }
+  plot.series = {sim, ref, exp};
+  ASSERT_NO_THROW(plot_curves_png(plot, png));
+
+  const Image img = read_png(png);
+  ASSERT_EQ(img.width, 1000);
+  ASSERT_EQ(img.height, 700);
+  // Series colours are matplotlib's tab10 in order: blue, orange, green.
+  const std::array<int, 3> blue{31, 119, 180}, orange{255, 127, 14}, green{44, 160, 44};
+  long n_blue = 0, n_orange = 0, n_green = 0, n_background = 0;
+  std::set<int> colours;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const Rgb c = img.at(x, y);
+      n_blue += near(c, blue, 12) ? 1 : 0;
+      n_orange += near(c, orange, 12) ? 1 : 0;
+      n_green += near(c, green, 12) ? 1 : 0;
+      n_background += is_background(c) ? 1 : 0;
+      colours.insert((c.r << 16) | (c.g << 8) | c.b);
+    }
+  }
+  const double share_foreground = 1.0 - n_background / (double(img.width) * img.height);
+  std::cout << "plot: blue " << n_blue << ", orange " << n_orange << ", green " << n_green
+            << ", distinct colours " << colours.size() << ", non-background share "
+            << share_foreground << "\n";
+  // The solid blue line crosses the ~900 px wide plot area at 2.5 px width: thousands of pixels
+  // (measured 2,079); the dashed green one less (427: dashes, and anti-aliased where it
+  // crosses the blue one); the 11 orange markers plus the legend's (1,040).
+  EXPECT_GT(n_blue, 1000);
+  EXPECT_GT(n_green, 200);
+  EXPECT_GT(n_orange, 300);
+  // Not a uniform image: lines, grid, text, legend (measured 7.1 % non-background, 290 colours).
+  EXPECT_GT(colours.size(), 50u);
+  EXPECT_GT(share_foreground, 0.03);
+  EXPECT_LT(share_foreground, 0.30);
+}
+
+TEST(Render, UnknownFieldThrowsWithTheNames)
+{
+  MeshFigure figure;
+  figure.field = "shear_angle_deg";
+  try {
+    render_mesh_png(slab(2, 2), figure, output_dir() / "never.png");
+    FAIL() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("unknown field 'shear_angle_deg'"), std::string::npos) << what;
+    EXPECT_NE(what.find("temperature"), std::string::npos) << what;
+  }
+  EXPECT_FALSE(fs::exists(output_dir() / "never.png"));
+}
+
+TEST(Render, BadInputThrows)
+{
+  RenderMesh bad = slab(2, 2);
+  bad.hex8[3] = 1000; // node id out of range
+  MeshFigure figure;
+  figure.field = "temperature";
+  EXPECT_THROW(render_mesh_png(bad, figure, output_dir() / "never.png"), std::runtime_error);
+
+  RenderMesh short_field = slab(2, 2);
+  short_field.fields[0].values.pop_back();
+  EXPECT_THROW(render_mesh_png(short_field, figure, output_dir() / "never.png"),
+               std::runtime_error);
+
+  figure.component = 3; // temperature has one component
+  EXPECT_THROW(render_mesh_png(slab(2, 2), figure, output_dir() / "never.png"),
+               std::runtime_error);
+
+  CurvePlot plot;
+  plot.series = {CurveSeries{"a", {0.0, 1.0}, {0.0}, false, false}};
+  EXPECT_THROW(plot_curves_png(plot, output_dir() / "never.png"), std::runtime_error);
+  EXPECT_FALSE(fs::exists(output_dir() / "never.png"));
+}

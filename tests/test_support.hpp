@@ -1,0 +1,56 @@
+#pragma once
+// Shared helpers for the engine tests: one tolerance comparator and small model builders.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+
+#include "fem/model.hpp"
+#include "fem/solver.hpp"
+
+namespace ncfsim::test {
+
+/// |a - b| <= rel * max(|a|, |b|) + abs
+inline ::testing::AssertionResult near_rel(double a, double b, double rel, double abs = 0.0) {
+  const double tol = rel * std::max(std::abs(a), std::abs(b)) + abs;
+  if (std::abs(a - b) <= tol) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << a << " vs " << b << ": difference " << std::abs(a - b)
+                                       << " > tolerance " << tol << " (rel " << rel << ")";
+}
+
+/// Nodes whose coordinate `axis` equals `value` within `tol`.
+inline std::vector<std::int32_t> nodes_at(const fem::Mesh& m, int axis, double value, double tol = 1e-9) {
+  std::vector<std::int32_t> out;
+  for (std::size_t i = 0; i < m.n_nodes(); ++i)
+    if (std::abs(m.coords[3 * i + axis] - value) <= tol) out.push_back(static_cast<std::int32_t>(i));
+  return out;
+}
+
+inline std::vector<std::int32_t> nodes_where(const fem::Mesh& m,
+                                             const std::function<bool(double, double, double)>& pred) {
+  std::vector<std::int32_t> out;
+  for (std::size_t i = 0; i < m.n_nodes(); ++i)
+    if (pred(m.coords[3 * i], m.coords[3 * i + 1], m.coords[3 * i + 2]))
+      out.push_back(static_cast<std::int32_t>(i));
+  return out;
+}
+
+/// A model with one solid part made of a structured block, isotropic elastic.
+inline void add_elastic_block(fem::Model& model, const std::string& part, std::array<double, 3> origin,
+                              std::array<double, 3> size, std::array<int, 3> div, double rho,
+                              double E, double nu) {
+  const int p = model.mesh.add_part(part);
+  fem::add_hex_block(model.mesh, p, origin, size, div);
+  model.materials.push_back(std::make_unique<fem::ElasticIsotropic>(part + "_mat", rho, E, nu));
+  if (static_cast<int>(model.parts.size()) <= p) model.parts.resize(static_cast<std::size_t>(p) + 1);
+  model.parts[static_cast<std::size_t>(p)].kind = fem::PartProperties::Kind::Solid;
+  model.parts[static_cast<std::size_t>(p)].material = static_cast<int>(model.materials.size()) - 1;
+}
+
+inline double node_coord(const fem::ExplicitSolver& s, std::int32_t node, int c) {
+  auto X = s.x.view();
+  return X[3 * static_cast<std::size_t>(node) + c];
+}
+
+}  // namespace ncfsim::test

@@ -1,0 +1,80 @@
+// ncfsim::render — off-screen figures: mesh pictures coloured by a field, and x-y curve plots.
+//
+// Plain-data inputs, no dependency on the rest of ncfsim. Rendering uses VTK on a Mesa EGL
+// surfaceless context (no X display needed, DISPLAY is never read). An executable that calls these
+// functions must be set up with the CMake function ncfsim_enable_offscreen_rendering(<target>)
+// (workflow/render/CMakeLists.txt), which links ncfsim_render and exports the glewInit shim.
+//
+// Every function that renders throws std::runtime_error with a readable message on any failure
+// (no EGL, bad input, unknown field, VTK error, PNG not writable). PNGs are written atomically:
+// a temporary file in the destination folder, then a rename.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ncfsim::render {
+
+// One field on a RenderMesh. values: [n_components * n_entities], component fastest, where the
+// entities are the points (on_cells = false) or the cells, hexes first then bars (on_cells = true).
+struct MeshField {
+  std::string name;
+  std::string unit;
+  bool on_cells = false;
+  int n_components = 1;
+  std::vector<double> values;
+};
+
+struct RenderMesh {
+  std::vector<double> points;       // xyz interleaved, [3*n_points]
+  std::vector<std::int64_t> hex8;   // 8 node ids per hexahedron (VTK ordering)
+  std::vector<std::int64_t> bar2;   // 2 node ids per bar
+  std::vector<MeshField> fields;    // cell fields have values for hexes first, then bars
+};
+
+// Top: looking down -z, +y up. Front: looking along +y, +z up. Iso: from the (+x, -y, +z) octant,
+// direction (1, -1.2, 1.5) so that the three visible faces of a box shade differently, +z up.
+// All use a parallel (orthographic) projection; the camera is then fitted with ResetCamera.
+enum class CameraPreset { Top, Iso, Front };
+
+struct MeshFigure {
+  std::string field;     // name of a RenderMesh field; empty = plain grey geometry, no scalar bar
+  int component = -1;    // -1 = magnitude (the value itself for a 1-component field)
+  std::string title;     // drawn at the top centre; empty = no title
+  CameraPreset camera = CameraPreset::Iso;
+  int width = 1200, height = 900;
+  std::optional<std::array<double, 2>> range; // colour range; default = data range (finite values)
+};
+
+// Surface of the hexahedra plus the bars as lines, coloured by the field (blue = low, red = high),
+// a scalar bar titled "name [unit]", the figure title, white background.
+void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
+                     const std::filesystem::path& png);
+
+struct CurveSeries {
+  std::string label;
+  std::vector<double> x, y;
+  bool dashed = false;
+  bool markers_only = false;
+};
+
+// Line chart: one colour per series (tab10 palette, in order), legend, axis titles.
+// Put the units in the labels, e.g. x_label = "punch displacement [mm]".
+struct CurvePlot {
+  std::string title, x_label, y_label;
+  std::vector<CurveSeries> series;
+  int width = 1000, height = 700;
+};
+
+void plot_curves_png(const CurvePlot& plot, const std::filesystem::path& png);
+
+// True when an off-screen OpenGL context can be created and VTK will accept it (EGL surfaceless
+// context, OpenGL >= 3.2 core, glewInit shim exported by the executable). Otherwise false and,
+// when why is given, the reason. Never throws.
+bool offscreen_rendering_available(std::string* why = nullptr);
+
+} // namespace ncfsim::render
