@@ -1,0 +1,146 @@
+#include "fem/io/result_reader.hpp"
+
+#include <hdf5.h>
+
+#include <map>
+#include <stdexcept>
+
+#include "fem/io/io_detail.hpp"
+
+namespace ncfsim::fem::io {
+
+namespace {
+
+struct Handle {
+  hid_t id = -1;
+  herr_t (*close)(hid_t) = nullptr;
+  Handle(hid_t i, herr_t (*c)(hid_t)) : id(i), close(c) {}
+  ~Handle() {
+    if (id >= 0 && close) close(id);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+};
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
+  throw std::runtime_error(file.string() + ": " + what);
+}
+
+// Reads a dataset of rank 1 or 2 as doubles (or int64 with `as_int`); returns dims.
+std::vector<hsize_t> read_dataset(const std::filesystem::path& file, hid_t loc, const std::string& name,
+                                  hid_t mem_type, void* (*resize)(void*, std::size_t), void* target) {
+  if (H5Lexists(loc, name.c_str(), H5P_DEFAULT) <= 0) fail(file, "no dataset '" + name + "'");
+  Handle d(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (d.id < 0) fail(file, "cannot open dataset '" + name + "'");
+  Handle s(H5Dget_space(d.id), H5Sclose);
+  const int rank = H5Sget_simple_extent_ndims(s.id);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(std::max(rank, 0)));
+  H5Sget_simple_extent_dims(s.id, dims.data(), nullptr);
+  std::size_t count = 1;
+  for (auto v : dims) count *= v;
+  void* buf = resize(target, count);
+  if (count && H5Dread(d.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
+    fail(file, "cannot read dataset '" + name + "'");
+  return dims;
+}
+
+template <class T>
+void* resize_vec(void* v, std::size_t n) {
+  auto* vec = static_cast<std::vector<T>*>(v);
+  vec->resize(n);
+  return vec->data();
+}
+
+std::vector<std::string> list_links(hid_t group) {
+  std::vector<std::string> names;
+  H5Literate(group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
+              [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
+                static_cast<std::vector<std::string>*>(data)->push_back(name);
+                return 0;
+              },
+              &names);
+  return names;
+}
+
+bool is_group(hid_t loc, const std::string& name) {
+  H5O_info_t info;
+  if (H5Oget_info_by_name2(loc, name.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) < 0) return false;
+  return info.type == H5O_TYPE_GROUP;
+}
+
+}  // namespace
+
+ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
+  if (!std::filesystem::exists(path_)) fail(path_, "no such file");
+  Handle f(H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (f.id < 0) fail(path_, "not a readable HDF5 file");
+  {
+    Handle a(H5Aopen(f.id, "n_frames", H5P_DEFAULT), H5Aclose);
+    if (a.id < 0) fail(path_, "no attribute n_frames (not an ncfsim results file)");
+    std::int32_t nf = 0;
+    H5Aread(a.id, H5T_NATIVE_INT32, &nf);
+    n_frames_ = static_cast<std::size_t>(std::max(nf, 0));
+  }
+  Handle g(H5Gopen2(f.id, "mesh", H5P_DEFAULT), H5Gclose);
+  if (g.id < 0) fail(path_, "no group /mesh");
+  read_dataset(path_, g.id, "points", H5T_NATIVE_DOUBLE, resize_vec<double>, &mesh_.points);
+  if (H5Lexists(g.id, "hex8", H5P_DEFAULT) > 0)
+    read_dataset(path_, g.id, "hex8", H5T_NATIVE_INT64, resize_vec<std::int64_t>, &mesh_.hex8);
+  if (H5Lexists(g.id, "bar2", H5P_DEFAULT) > 0)
+    read_dataset(path_, g.id, "bar2", H5T_NATIVE_INT64, resize_vec<std::int64_t>, &mesh_.bar2);
+  if (H5Lexists(g.id, "hex_part", H5P_DEFAULT) > 0)
+    read_dataset(path_, g.id, "hex_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>, &mesh_.hex_part);
+  if (H5Lexists(g.id, "bar_part", H5P_DEFAULT) > 0)
+    read_dataset(path_, g.id, "bar_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>, &mesh_.bar_part);
+}
+
+StoredFrame ResultReader::frame(std::size_t index) const {
+  if (index >= n_frames_) fail(path_, "frame " + std::to_string(index) + " not in the file");
+  Handle f(H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (f.id < 0) fail(path_, "not a readable HDF5 file");
+  const std::string gname = "/frames/" + detail::zero_padded(index, 6);
+  Handle g(H5Gopen2(f.id, gname.c_str(), H5P_DEFAULT), H5Gclose);
+  if (g.id < 0) fail(path_, "no group " + gname);
+  StoredFrame fr;
+  {
+    Handle a(H5Aopen(g.id, "time", H5P_DEFAULT), H5Aclose);
+    if (a.id >= 0) H5Aread(a.id, H5T_NATIVE_DOUBLE, &fr.time);
+    Handle c(H5Aopen(g.id, "cycle", H5P_DEFAULT), H5Aclose);
+    if (c.id >= 0) H5Aread(c.id, H5T_NATIVE_INT, &fr.cycle);
+  }
+  read_dataset(path_, g.id, "coordinates", H5T_NATIVE_DOUBLE, resize_vec<double>, &fr.coordinates);
+  const std::size_t np = mesh_.n_points(), nh = mesh_.n_hex(), nb = mesh_.n_bar();
+  for (const auto& name : list_links(g.id)) {
+    if (name == "coordinates" || is_group(g.id, name)) continue;
+    FrameField ff;
+    ff.name = name;
+    const auto dims = read_dataset(path_, g.id, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &ff.values);
+    ff.n_components = dims.size() > 1 ? static_cast<int>(dims[1]) : 1;
+    fr.fields.push_back(std::move(ff));
+  }
+  // Cell fields: join the hex and bar slices (missing slice -> NaN).
+  std::map<std::string, FrameField> cells;
+  for (const char* kind : {"hex8", "bar2"}) {
+    if (H5Lexists(g.id, kind, H5P_DEFAULT) <= 0) continue;
+    Handle cg(H5Gopen2(g.id, kind, H5P_DEFAULT), H5Gclose);
+    const bool hex = std::string(kind) == "hex8";
+    for (const auto& name : list_links(cg.id)) {
+      std::vector<double> vals;
+      const auto dims = read_dataset(path_, cg.id, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &vals);
+      const int nc = dims.size() > 1 ? static_cast<int>(dims[1]) : 1;
+      auto& ff = cells[name];
+      if (ff.values.empty()) {
+        ff.name = name, ff.on_cells = true, ff.n_components = nc;
+        ff.values.assign(static_cast<std::size_t>(nc) * (nh + nb), std::numeric_limits<double>::quiet_NaN());
+      }
+      if (nc != ff.n_components) continue;
+      const std::size_t offset = hex ? 0 : static_cast<std::size_t>(nc) * nh;
+      for (std::size_t i = 0; i < vals.size() && offset + i < ff.values.size(); ++i) ff.values[offset + i] = vals[i];
+    }
+  }
+  for (auto& [name, ff] : cells) fr.fields.push_back(std::move(ff));
+  (void)np;
+  return fr;
+}
+
+}  // namespace ncfsim::fem::io

@@ -1,0 +1,410 @@
+#include "workflow/case/engine_case.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "fem/errors.hpp"
+#include "fem/mesh.hpp"
+#include "workflow/case/toml_reader.hpp"
+
+namespace ncfsim::workflow {
+
+namespace {
+
+using fem::V3;
+
+V3 to_v3(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+
+double resolution_factor(const std::string& r) {
+  if (r == "coarse") return 0.5;
+  if (r == "fine") return 2.0;
+  return 1.0;
+}
+
+int axis_index(const TableReader& t, std::string_view key, const std::string& value) {
+  if (value == "x") return 0;
+  if (value == "y") return 1;
+  if (value == "z") return 2;
+  t.fail(key, "'" + value + "' is not an axis; one of 'x', 'y', 'z'");
+}
+
+std::array<bool, 3> read_dofs(const TableReader& t, std::string_view key, std::array<bool, 3> fallback) {
+  if (!t.has(key)) return fallback;
+  std::array<bool, 3> d{false, false, false};
+  for (const auto& s : t.strings(key)) d[static_cast<std::size_t>(axis_index(t, key, s))] = true;
+  return d;
+}
+
+// Node selection: the intersection of the criteria given (part, box, plane); "all" if none.
+std::vector<std::int32_t> select_nodes(const TableReader& owner, std::string_view key, const fem::Mesh& mesh) {
+  auto sel = owner.table(key);
+  if (!sel) owner.fail(key, "missing (required node selection, e.g. { part = \"beam\" } or "
+                            "{ axis = \"x\", value = 0.0 })");
+  const std::size_t n = mesh.n_nodes();
+  std::vector<char> keep(n, 1);
+  bool any = false;
+  if (sel->has("part")) {
+    any = true;
+    std::vector<std::string> names;
+    if (sel->has("part")) {
+      // a string or an array of strings
+      try {
+        names = {sel->string("part")};
+      } catch (const InputError&) {
+        names = sel->strings("part");
+      }
+    }
+    std::vector<char> in_part(n, 0);
+    for (const auto& name : names) {
+      const int p = mesh.find_part(name);
+      if (p < 0) sel->fail("part", "no part named '" + name + "'");
+      for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
+        if (mesh.hex_part[e] == p)
+          for (auto node : mesh.hexes[e]) in_part[static_cast<std::size_t>(node)] = 1;
+      for (std::size_t e = 0; e < mesh.bars.size(); ++e)
+        if (mesh.bar_part[e] == p)
+          for (auto node : mesh.bars[e]) in_part[static_cast<std::size_t>(node)] = 1;
+    }
+    for (std::size_t i = 0; i < n; ++i) keep[i] &= in_part[i];
+  }
+  const double tol = sel->number("tolerance", 1e-9, Range::non_negative());
+  if (sel->has("box_min") || sel->has("box_max")) {
+    any = true;
+    const auto lo = sel->vec3("box_min"), hi = sel->vec3("box_max");
+    for (std::size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const double v = mesh.coords[3 * i + static_cast<std::size_t>(c)];
+        if (v < lo[static_cast<std::size_t>(c)] - tol || v > hi[static_cast<std::size_t>(c)] + tol) keep[i] = 0;
+      }
+  }
+  if (sel->has("axis") || sel->has("value")) {
+    any = true;
+    const int a = axis_index(*sel, "axis", sel->string("axis"));
+    const double value = sel->number("value", {});
+    for (std::size_t i = 0; i < n; ++i)
+      if (std::abs(mesh.coords[3 * i + static_cast<std::size_t>(a)] - value) > tol) keep[i] = 0;
+  }
+  if (sel->has("all")) {
+    any = true;
+    if (!sel->boolean("all", false)) sel->fail("all", "only `all = true` is meaningful");
+  }
+  if (!any) owner.fail(key, "selects nothing: give part, box_min/box_max, axis/value or all = true");
+  std::vector<std::int32_t> out;
+  for (std::size_t i = 0; i < n; ++i)
+    if (keep[i]) out.push_back(static_cast<std::int32_t>(i));
+  if (out.empty()) owner.fail(key, "the selection holds no node (check coordinates and tolerance)");
+  return out;
+}
+
+std::unique_ptr<fem::SolidMaterial> read_material(const TableReader& t, const std::string& name) {
+  const std::string type = t.choice("type", {"elastic_isotropic", "elastic_orthotropic"}, "");
+  const double rho = t.number("density", Range::positive());
+  try {
+    if (type == "elastic_isotropic") {
+      const double E = t.number("youngs_modulus", Range::positive());
+      const double nu = t.number("poisson_ratio", {-1.0, 0.5, true, true});
+      return std::make_unique<fem::ElasticIsotropic>(name, rho, E, nu);
+    }
+    fem::OrthotropicConstants c{};
+    c.E1 = t.number("E1", Range::positive());
+    c.E2 = t.number("E2", Range::positive());
+    c.E3 = t.number("E3", Range::positive());
+    c.nu12 = t.number("nu12", {-1.0, 1.0, true, true});
+    c.nu13 = t.number("nu13", {-1.0, 1.0, true, true});
+    c.nu23 = t.number("nu23", {-1.0, 1.0, true, true});
+    c.G12 = t.number("G12", Range::positive());
+    c.G13 = t.number("G13", Range::positive());
+    c.G23 = t.number("G23", Range::positive());
+    return std::make_unique<fem::ElasticOrthotropic>(name, rho, c);
+  } catch (const std::invalid_argument& e) {
+    t.fail("type", e.what());
+  }
+}
+
+fem::BarForceLaw read_bar_law(const TableReader& t, const std::string& name) {
+  const std::string type = t.choice("type", {"linear", "tabulated"}, "");
+  const double rho_l = t.number("linear_density", Range::positive());
+  const bool tension_only = t.boolean("tension_only", false);
+  try {
+    if (type == "linear") return fem::BarForceLaw::linear(name, t.number("axial_stiffness", Range::positive()), tension_only, rho_l);
+    auto strain = t.numbers("strain", {}, 2);
+    auto force = t.numbers("force", {}, 2);
+    if (strain.size() != force.size()) t.fail("force", "needs as many values as `strain`");
+    return fem::BarForceLaw(name, strain, force, tension_only, rho_l);
+  } catch (const std::invalid_argument& e) {
+    t.fail("strain", e.what());
+  }
+}
+
+std::array<double, 9> read_axes(const TableReader& t) {
+  if (!t.has("material_axis_1") && !t.has("material_axis_2")) return fem::kIdentityAxes;
+  auto a = to_v3(t.vec3("material_axis_1"));
+  auto b = to_v3(t.vec3_or("material_axis_2", {0, 1, 0}));
+  const double na = norm(a);
+  if (!(na > 0)) t.fail("material_axis_1", "must not be zero");
+  a = (1.0 / na) * a;
+  b = b - dot(a, b) * a;
+  const double nb = norm(b);
+  if (!(nb > 1e-8)) t.fail("material_axis_2", "must not be parallel to material_axis_1");
+  b = (1.0 / nb) * b;
+  const V3 c = cross(a, b);
+  return {a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z};
+}
+
+void read_tools(const TableReader& root, EngineCase& ec, const std::string& file) {
+  for (const auto& t : root.tables("tool")) {
+    fem::RigidTool tool;
+    tool.name = t.string("name");
+    const std::string shape =
+        t.choice("shape", {"plane", "sphere", "cylinder", "torus", "plane_with_hole", "stl"}, "");
+    auto& s = tool.surface;
+    s.point = to_v3(t.vec3_or("point", {0, 0, 0}));
+    if (t.has("axis") || shape != "stl") {
+      V3 ax = to_v3(t.vec3_or("axis", {0, 0, 1}));
+      if (!(norm(ax) > 0)) t.fail("axis", "must not be zero");
+      s.axis = (1.0 / norm(ax)) * ax;
+    }
+    if (shape == "plane") s.shape = fem::ToolShape::Plane;
+    if (shape == "sphere" || shape == "cylinder" || shape == "torus" || shape == "plane_with_hole") {
+      s.shape = shape == "sphere" ? fem::ToolShape::Sphere
+              : shape == "cylinder" ? fem::ToolShape::Cylinder
+              : shape == "torus" ? fem::ToolShape::Torus
+                                 : fem::ToolShape::PlaneWithHole;
+      s.radius = t.number("radius", Range::positive());
+    }
+    if (shape == "torus") s.minor_radius = t.number("minor_radius", Range::positive());
+    if (shape == "sphere" || shape == "cylinder" || shape == "torus") s.body_inside = t.boolean("body_inside", false);
+    if (shape == "stl") {
+      s.shape = fem::ToolShape::Triangles;
+      std::filesystem::path stl = t.string("file");
+      if (stl.is_relative()) stl = std::filesystem::path(file).parent_path() / stl;
+      const double scale = t.number("scale", 1.0, Range::positive());
+      try {
+        s.triangles = std::make_shared<fem::TriangleSurface>(fem::TriangleSurface::read_stl(stl.string(), scale));
+      } catch (const std::exception& e) {
+        t.fail("file", std::string("cannot read STL: ") + e.what());
+      }
+      s.search_radius = t.number("search_radius", Range::positive());
+    }
+    const std::string motion = t.choice("motion", {"fixed", "velocity", "force"}, "fixed");
+    if (motion == "velocity") {
+      tool.motion.kind = fem::ToolMotion::Kind::Velocity;
+      tool.motion.velocity = to_v3(t.vec3("velocity"));
+      tool.motion.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
+    } else if (motion == "force") {
+      tool.motion.kind = fem::ToolMotion::Kind::Force;
+      V3 ax = to_v3(t.vec3_or("force_axis", {0, 0, -1}));
+      if (!(norm(ax) > 0)) t.fail("force_axis", "must not be zero");
+      tool.motion.axis = (1.0 / norm(ax)) * ax;
+      tool.motion.force = t.number("force", Range::non_negative());
+      tool.motion.mass = t.number("mass", Range::positive());
+    }
+    tool.friction = t.number("friction", 0.0, Range::non_negative());
+    tool.penalty_scale = t.number("penalty_scale", 0.1, Range::open_closed(0, 1.0));
+    tool.thickness = t.number("thickness", 0.0, Range::non_negative());
+    tool.contact_nodes = select_nodes(t, "contact_nodes", ec.model.mesh);
+    ec.model.tools.push_back(std::move(tool));
+  }
+}
+
+}  // namespace
+
+EngineCase load_engine_case(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  CaseDocument doc = CaseDocument::load(file, overrides);
+  const std::string fname = file.string();
+  TableReader root(doc, doc.root(), "");
+  EngineCase ec;
+  ec.file = file;
+
+  const TableReader c = root.required_table("case");
+  ec.name = c.string("name");
+  if (ec.name.empty() || ec.name.find_first_of("/\\ ") != std::string::npos)
+    c.fail("name", "must be a non-empty name without spaces or slashes (it names the output folder)");
+  ec.kind = c.choice("kind", {"engine"}, "engine");
+  ec.description = c.string("description", "");
+
+  // Mesh.
+  if (!root.has("mesh"))
+    root.fail("mesh", "missing (required section [mesh] with [[mesh.block]] or [[mesh.line]] entries)");
+  const TableReader m = root.required_table("mesh");
+  ec.resolution = m.choice("resolution", {"coarse", "default", "fine"}, "default");
+  const double rf = resolution_factor(ec.resolution);
+  fem::Mesh& mesh = ec.model.mesh;
+  std::map<std::string, std::string> part_kind;  // part -> "solid" | "bar"
+  const auto blocks = m.tables("block");
+  const auto lines = m.tables("line");
+  if (blocks.empty() && lines.empty())
+    m.fail("block", "the mesh has no elements: give at least one [[mesh.block]] or [[mesh.line]]");
+  for (const auto& b : blocks) {
+    const std::string part = b.string("part");
+    const auto origin = b.vec3_or("origin", {0, 0, 0});
+    const auto size = b.vec3("size", Range::positive());
+    const auto divv = b.numbers("divisions", Range::closed(1, 1e6), 3);
+    if (divv.size() != 3) b.fail("divisions", "must hold exactly 3 integers [nx, ny, nz]");
+    std::array<int, 3> div{};
+    for (int k = 0; k < 3; ++k) {
+      const double d = divv[static_cast<std::size_t>(k)];
+      if (d != std::floor(d)) b.fail("divisions", "must be integers");
+      div[static_cast<std::size_t>(k)] = d == 1 ? 1 : std::max(1, static_cast<int>(std::lround(d * rf)));
+    }
+    if (part_kind.count(part) && part_kind[part] != "solid")
+      b.fail("part", "'" + part + "' already holds bars");
+    part_kind[part] = "solid";
+    int p = mesh.find_part(part);
+    if (p < 0) p = mesh.add_part(part);
+    fem::add_hex_block(mesh, p, origin, size, div);
+  }
+  for (const auto& l : lines) {
+    const std::string part = l.string("part");
+    const auto a = l.vec3("start"), bnd = l.vec3("end");
+    const int nd = static_cast<int>(l.integer("divisions", 1, 1000000));
+    const int n_div = std::max(1, static_cast<int>(std::lround(nd * rf)));
+    if (part_kind.count(part) && part_kind[part] != "bar") l.fail("part", "'" + part + "' already holds hexahedra");
+    part_kind[part] = "bar";
+    int p = mesh.find_part(part);
+    if (p < 0) p = mesh.add_part(part);
+    const std::int32_t first = static_cast<std::int32_t>(mesh.n_nodes());
+    for (int i = 0; i <= n_div; ++i) {
+      const double s = static_cast<double>(i) / n_div;
+      for (int k = 0; k < 3; ++k)
+        mesh.coords.push_back(a[static_cast<std::size_t>(k)] + s * (bnd[static_cast<std::size_t>(k)] - a[static_cast<std::size_t>(k)]));
+    }
+    for (int i = 0; i < n_div; ++i) {
+      mesh.bars.push_back({first + i, first + i + 1});
+      mesh.bar_part.push_back(p);
+    }
+  }
+  fem::renumber_for_locality(mesh);
+  mesh.fill_default_user_ids();
+
+  // Materials and bar laws.
+  std::map<std::string, int> materials, bar_laws;
+  for (const auto& t : root.tables("material")) {
+    const std::string name = t.string("name");
+    if (materials.count(name)) t.fail("name", "duplicate material '" + name + "'");
+    ec.model.materials.push_back(read_material(t, name));
+    materials[name] = static_cast<int>(ec.model.materials.size()) - 1;
+  }
+  for (const auto& t : root.tables("bar_law")) {
+    const std::string name = t.string("name");
+    if (bar_laws.count(name)) t.fail("name", "duplicate bar law '" + name + "'");
+    ec.model.bar_laws.push_back(read_bar_law(t, name));
+    bar_laws[name] = static_cast<int>(ec.model.bar_laws.size()) - 1;
+  }
+
+  // Parts.
+  ec.model.parts.assign(mesh.part_names.size(), {});
+  std::vector<char> defined(mesh.part_names.size(), 0);
+  for (const auto& t : root.tables("part")) {
+    const std::string name = t.string("name");
+    const int p = mesh.find_part(name);
+    if (p < 0) t.fail("name", "no mesh block or line uses part '" + name + "'");
+    auto& pp = ec.model.parts[static_cast<std::size_t>(p)];
+    defined[static_cast<std::size_t>(p)] = 1;
+    if (part_kind[name] == "solid") {
+      pp.kind = fem::PartProperties::Kind::Solid;
+      const std::string mat = t.string("material");
+      if (!materials.count(mat)) t.fail("material", "no [[material]] named '" + mat + "'");
+      pp.material = materials[mat];
+      pp.material_axes = read_axes(t);
+      pp.hourglass_stiffness = t.number("hourglass_stiffness", 1.0, Range::closed(0, 10));
+      pp.hourglass_viscosity = t.number("hourglass_viscosity", 0.05, Range::closed(0, 1));
+    } else {
+      pp.kind = fem::PartProperties::Kind::Bar;
+      const std::string law = t.string("bar_law");
+      if (!bar_laws.count(law)) t.fail("bar_law", "no [[bar_law]] named '" + law + "'");
+      pp.bar_law = bar_laws[law];
+    }
+  }
+  for (std::size_t p = 0; p < defined.size(); ++p)
+    if (!defined[p]) root.fail("part", "part '" + mesh.part_names[p] + "' has no [[part]] entry (material)");
+
+  // Boundary conditions, loads, initial conditions.
+  if (auto bc = root.table("boundary")) {
+    for (const auto& t : bc->tables("fixed")) {
+      fem::FixedDofs fx;
+      fx.name = t.string("name");
+      fx.nodes = select_nodes(t, "nodes", mesh);
+      fx.dofs = read_dofs(t, "dofs", {true, true, true});
+      ec.reactions.push_back({fx.name, fx.nodes});
+      ec.model.fixed.push_back(std::move(fx));
+    }
+    for (const auto& t : bc->tables("velocity")) {
+      fem::PrescribedVelocity pv;
+      pv.name = t.string("name");
+      pv.nodes = select_nodes(t, "nodes", mesh);
+      pv.velocity = to_v3(t.vec3("velocity"));
+      pv.dofs = read_dofs(t, "dofs", {true, true, true});
+      pv.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
+      pv.start_time = t.number("start_time", 0.0, Range::non_negative());
+      ec.reactions.push_back({pv.name, pv.nodes});
+      ec.model.velocities.push_back(std::move(pv));
+    }
+  }
+  if (auto ld = root.table("load")) {
+    ec.model.gravity = to_v3(ld->vec3_or("gravity", {0, 0, 0}));
+    for (const auto& t : ld->tables("nodal_force")) {
+      fem::NodalLoad l;
+      l.name = t.string("name");
+      l.nodes = select_nodes(t, "nodes", mesh);
+      l.force_per_node = (1.0 / static_cast<double>(l.nodes.size())) * to_v3(t.vec3("total_force"));
+      l.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
+      ec.model.loads.push_back(std::move(l));
+    }
+  }
+  if (auto d = root.table("damping")) ec.model.mass_damping = d->number("mass_proportional", 0.0, Range::non_negative());
+  if (auto init = root.table("initial"))
+    for (const auto& t : init->tables("velocity"))
+      ec.model.initial_velocities.push_back({select_nodes(t, "nodes", mesh), to_v3(t.vec3("velocity"))});
+
+  read_tools(root, ec, fname);
+
+  // Time controls.
+  const TableReader tc = root.required_table("time");
+  auto& time = ec.model.time;
+  time.end_time = tc.number("end_time", Range::positive());
+  time.safety_factor = tc.number("safety_factor", 0.9, Range::open_closed(0, 1));
+  time.mass_scaling_dt = tc.number("mass_scaling_dt", 0.0, Range::non_negative());
+  time.history_interval = tc.number("history_interval", time.end_time / 200, Range::positive());
+  time.frame_interval = tc.number("frame_interval", time.end_time / 20, Range::positive());
+  time.max_cycles = tc.integer("max_cycles", 0, 0, std::int64_t{1} << 50);
+  time.energy_balance_limit = tc.number("energy_balance_limit", 0.05, Range::open_closed(0, 1));
+
+  // Output.
+  if (auto o = root.table("output")) {
+    const std::string frames = o->choice("frames", {"xdmf", "vtu", "both", "none"}, "xdmf");
+    ec.output.xdmf = frames == "xdmf" || frames == "both";
+    ec.output.vtu = frames == "vtu" || frames == "both";
+    ec.output.figures = o->boolean("figures", true);
+    ec.output.report = o->boolean("report", false);
+    for (const auto& t : o->tables("probe")) ec.probes.push_back({t.string("name"), select_nodes(t, "nodes", mesh)});
+  }
+  if (auto f = root.table("figures")) {
+    for (const auto& t : f->tables("plot")) {
+      PlotSpec p;
+      p.name = t.string("name");
+      p.title = t.string("title", p.name);
+      p.x = t.string("x", "time");
+      p.y = t.strings("y");
+      p.x_scale = t.number("x_scale", 1.0, {});
+      p.y_scale = t.number("y_scale", 1.0, {});
+      p.x_label = t.string("x_label", p.x);
+      p.y_label = t.string("y_label", p.y.empty() ? "" : p.y.front());
+      ec.plots.push_back(std::move(p));
+    }
+    for (const auto& t : f->tables("picture")) {
+      PictureSpec p;
+      p.name = t.string("name");
+      p.field = t.choice("field", {"displacement_magnitude", "von_mises_stress", "none"}, "displacement_magnitude");
+      p.camera = t.choice("camera", {"iso", "top", "front"}, "iso");
+      p.title = t.string("title", "");
+      ec.pictures.push_back(std::move(p));
+    }
+  }
+
+  doc.check_unknown_keys();
+  return ec;
+}
+
+}  // namespace ncfsim::workflow

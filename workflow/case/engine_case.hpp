@@ -1,0 +1,67 @@
+#pragma once
+// A case for the explicit engine, read from TOML: mesh (structured blocks and bar lines), materials,
+// bar laws, parts, constraints, loads, rigid tools, time controls, output, figures.
+// The keys are documented in docs/case-file.md; every value is range-checked here, before any run.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "fem/model.hpp"
+
+namespace ncfsim::workflow {
+
+/// Mean displacement of a set of nodes, written to history.csv as <name>_displacement_{x,y,z}_m.
+struct DisplacementProbe {
+  std::string name;
+  std::vector<std::int32_t> nodes;
+};
+
+/// A named constraint set whose reaction goes to history.csv as <name>_reaction_{x,y,z}_N.
+struct ReactionProbe {
+  std::string name;
+  std::vector<std::int32_t> nodes;
+};
+
+struct OutputSettings {
+  bool xdmf = true;           // results.h5 + results.xdmf
+  bool vtu = false;           // frames/*.vtu + results.pvd
+  bool figures = true;        // render figures at the end of the run
+  bool report = false;        // write report.html at the end of the run
+};
+
+/// A curve plot from history.csv: y columns against an x column.
+struct PlotSpec {
+  std::string name;                 // file figures/<name>.png
+  std::string title;
+  std::string x;                    // column name
+  std::vector<std::string> y;       // column names
+  double x_scale = 1.0, y_scale = 1.0;
+  std::string x_label, y_label;
+};
+
+/// A picture of the last frame coloured by a field.
+struct PictureSpec {
+  std::string name;
+  std::string field;   // displacement_magnitude, von_mises_stress, ... (docs/output.md)
+  std::string camera;  // iso | top | front
+  std::string title;
+};
+
+struct EngineCase {
+  std::filesystem::path file;
+  std::string name;
+  std::string kind;          // "engine"
+  std::string description;
+  std::string resolution;    // coarse | default | fine
+  fem::Model model;
+  std::vector<DisplacementProbe> probes;
+  std::vector<ReactionProbe> reactions;
+  OutputSettings output;
+  std::vector<PlotSpec> plots;
+  std::vector<PictureSpec> pictures;
+};
+
+/// Reads and checks a case (throws InputError naming file and key). `overrides` are --set items.
+EngineCase load_engine_case(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+
+}  // namespace ncfsim::workflow

@@ -1,0 +1,308 @@
+#include "workflow/case/toml_reader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "fem/errors.hpp"
+
+namespace ncfsim::workflow {
+
+namespace {
+
+std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date/time";
+  }
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+// Strips array indices: "mesh.block[2].part" -> "mesh.block[].part".
+std::string generic(const std::string& path) {
+  std::string out;
+  bool in_index = false;
+  for (char c : path) {
+    if (c == '[') in_index = true, out += "[]";
+    else if (c == ']') in_index = false;
+    else if (!in_index) out += c;
+  }
+  return out;
+}
+
+void collect_leaves(const toml::table& t, const std::string& prefix, std::vector<std::string>& out) {
+  for (const auto& [k, v] : t) {
+    const std::string path = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    if (const auto* sub = v.as_table()) {
+      collect_leaves(*sub, path, out);
+    } else if (const auto* arr = v.as_array(); arr && arr->is_array_of_tables()) {
+      for (std::size_t i = 0; i < arr->size(); ++i)
+        collect_leaves(*arr->get(i)->as_table(), path + "[" + std::to_string(i) + "]", out);
+    } else {
+      out.push_back(path);
+    }
+  }
+}
+
+toml::table* ensure_table(toml::table& root, const std::vector<std::string>& parts, std::size_t upto,
+                          const std::string& file, const std::string& key) {
+  toml::table* t = &root;
+  for (std::size_t i = 0; i < upto; ++i) {
+    toml::node* n = t->get(parts[i]);
+    if (!n) {
+      t->insert(parts[i], toml::table{});
+      n = t->get(parts[i]);
+    }
+    if (!n->is_table())
+      throw InputError(file, key, "--set cannot descend into '" + parts[i] + "', which is " + type_name(*n));
+    t = n->as_table();
+  }
+  return t;
+}
+
+}  // namespace
+
+bool Range::contains(double v) const {
+  if (!std::isfinite(v)) return false;
+  if (lo_open ? !(v > lo) : !(v >= lo)) return false;
+  if (hi_open ? !(v < hi) : !(v <= hi)) return false;
+  return true;
+}
+
+std::string Range::describe() const {
+  std::ostringstream os;
+  os.precision(6);
+  const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
+  if (has_lo && has_hi) {
+    os << (lo_open ? "(" : "[") << lo << ", " << hi << (hi_open ? ")" : "]");
+  } else if (has_lo) {
+    os << (lo_open ? "> " : ">= ") << lo;
+  } else if (has_hi) {
+    os << (hi_open ? "< " : "<= ") << hi;
+  } else {
+    os << "finite";
+  }
+  return os.str();
+}
+
+CaseDocument CaseDocument::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  CaseDocument doc;
+  doc.file_ = file;
+  const std::string fname = file.string();
+  if (!std::filesystem::exists(file)) throw InputError(fname, "", "no such case file");
+  try {
+    doc.root_ = toml::parse_file(fname);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << "TOML syntax error at line " << e.source().begin.line << ", column " << e.source().begin.column
+       << ": " << e.description();
+    throw InputError(fname, "", os.str());
+  }
+  for (const std::string& ov : overrides) {
+    const auto eq = ov.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fname, ov, "--set needs KEY=VALUE (e.g. --set mesh.resolution=coarse)");
+    const std::string key = ov.substr(0, eq), value = ov.substr(eq + 1);
+    std::vector<std::string> parts;
+    std::stringstream ss(key);
+    for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+    if (parts.empty() || std::any_of(parts.begin(), parts.end(), [](auto& p) { return p.empty(); }))
+      throw InputError(fname, key, "--set: malformed key");
+    toml::table* t = ensure_table(doc.root_, parts, parts.size() - 1, fname, key);
+    toml::table parsed;
+    try {
+      parsed = toml::parse("v = " + value);
+    } catch (const toml::parse_error&) {
+      parsed = toml::table{{"v", value}};  // a bare word is a string
+    }
+    t->insert_or_assign(parts.back(), *parsed.get("v"));
+  }
+  return doc;
+}
+
+void CaseDocument::check_unknown_keys() const {
+  std::vector<std::string> leaves;
+  collect_leaves(root_, "", leaves);
+  std::set<std::string> known_generic;
+  for (const auto& r : read_) known_generic.insert(generic(r));
+  for (const auto& leaf : leaves) {
+    if (read_.count(leaf)) continue;
+    std::string hint;
+    std::size_t best = 4;
+    const std::string g = generic(leaf);
+    for (const auto& k : known_generic) {
+      const std::size_t d = edit_distance(g, k);
+      if (d < best) best = d, hint = k;
+    }
+    throw InputError(file_.string(), leaf,
+                     "unknown key" + (hint.empty() ? std::string(" (see docs/case-file.md)")
+                                                   : " (did you mean '" + hint + "'?)"));
+  }
+}
+
+TableReader::TableReader(CaseDocument& doc, const toml::table& table, std::string path)
+    : doc_(&doc), table_(table), path_(std::move(path)) {}
+
+std::string TableReader::key_path(std::string_view key) const {
+  return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+}
+
+void TableReader::fail(std::string_view key, const std::string& message) const {
+  throw InputError(doc_->file().string(), key_path(key), message);
+}
+
+const toml::node& TableReader::require(std::string_view key) const {
+  const toml::node* n = table_.get(key);
+  if (!n) fail(key, "missing (required)");
+  doc_->mark_read(key_path(key));
+  return *n;
+}
+
+double TableReader::as_number(std::string_view key, const toml::node& n) const {
+  if (auto v = n.value_exact<double>()) return *v;
+  if (auto v = n.value_exact<std::int64_t>()) return static_cast<double>(*v);
+  fail(key, "must be a number, got " + type_name(n));
+}
+
+double TableReader::number(std::string_view key, Range range) const {
+  const double v = as_number(key, require(key));
+  if (!range.contains(v)) {
+    std::ostringstream os;
+    os << "value " << v << " out of range, allowed " << range.describe();
+    fail(key, os.str());
+  }
+  return v;
+}
+
+double TableReader::number(std::string_view key, double fallback, Range range) const {
+  return has(key) ? number(key, range) : fallback;
+}
+
+std::int64_t TableReader::integer(std::string_view key, std::int64_t lo, std::int64_t hi) const {
+  const toml::node& n = require(key);
+  const auto v = n.value_exact<std::int64_t>();
+  if (!v) fail(key, "must be an integer, got " + type_name(n));
+  if (*v < lo || *v > hi)
+    fail(key, "value " + std::to_string(*v) + " out of range, allowed [" + std::to_string(lo) + ", " +
+                  std::to_string(hi) + "]");
+  return *v;
+}
+
+std::int64_t TableReader::integer(std::string_view key, std::int64_t fallback, std::int64_t lo,
+                                  std::int64_t hi) const {
+  return has(key) ? integer(key, lo, hi) : fallback;
+}
+
+bool TableReader::boolean(std::string_view key, bool fallback) const {
+  if (!has(key)) return fallback;
+  const toml::node& n = require(key);
+  const auto v = n.value_exact<bool>();
+  if (!v) fail(key, "must be true or false, got " + type_name(n));
+  return *v;
+}
+
+std::string TableReader::string(std::string_view key) const {
+  const toml::node& n = require(key);
+  const auto v = n.value_exact<std::string>();
+  if (!v) fail(key, "must be a string, got " + type_name(n));
+  return *v;
+}
+
+std::string TableReader::string(std::string_view key, const std::string& fallback) const {
+  return has(key) ? string(key) : fallback;
+}
+
+std::string TableReader::choice(std::string_view key, const std::vector<std::string>& choices,
+                                const std::string& fallback) const {
+  const std::string v = string(key, fallback);
+  if (std::find(choices.begin(), choices.end(), v) == choices.end()) {
+    std::string all;
+    for (const auto& c : choices) all += (all.empty() ? "" : ", ") + ("'" + c + "'");
+    fail(key, "'" + v + "' is not allowed; one of " + all);
+  }
+  return v;
+}
+
+std::vector<double> TableReader::numbers(std::string_view key, Range range, std::size_t min_size) const {
+  const toml::node& n = require(key);
+  const toml::array* a = n.as_array();
+  if (!a) fail(key, "must be an array of numbers, got " + type_name(n));
+  if (a->size() < min_size) fail(key, "needs at least " + std::to_string(min_size) + " values");
+  std::vector<double> out;
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const double v = as_number(key, *a->get(i));
+    if (!range.contains(v)) {
+      std::ostringstream os;
+      os << "entry " << i << " = " << v << " out of range, allowed " << range.describe();
+      fail(key, os.str());
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::array<double, 3> TableReader::vec3(std::string_view key, Range r) const {
+  const auto v = numbers(key, r, 3);
+  if (v.size() != 3) fail(key, "must hold exactly 3 numbers [x, y, z]");
+  return {v[0], v[1], v[2]};
+}
+
+std::array<double, 3> TableReader::vec3_or(std::string_view key, std::array<double, 3> fallback, Range r) const {
+  return has(key) ? vec3(key, r) : fallback;
+}
+
+std::vector<std::string> TableReader::strings(std::string_view key) const {
+  const toml::node& n = require(key);
+  const toml::array* a = n.as_array();
+  if (!a) fail(key, "must be an array of strings, got " + type_name(n));
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const auto v = a->get(i)->value_exact<std::string>();
+    if (!v) fail(key, "entry " + std::to_string(i) + " must be a string");
+    out.push_back(*v);
+  }
+  return out;
+}
+
+std::optional<TableReader> TableReader::table(std::string_view key) const {
+  const toml::node* n = table_.get(key);
+  if (!n) return std::nullopt;
+  if (!n->is_table()) fail(key, "must be a table, got " + type_name(*n));
+  return TableReader(*doc_, *n->as_table(), key_path(key));
+}
+
+TableReader TableReader::required_table(std::string_view key) const {
+  auto t = table(key);
+  if (!t) fail(key, "missing (required section [" + key_path(key) + "])");
+  return *t;
+}
+
+std::vector<TableReader> TableReader::tables(std::string_view key) const {
+  std::vector<TableReader> out;
+  const toml::node* n = table_.get(key);
+  if (!n) return out;
+  const toml::array* a = n->as_array();
+  if (!a || !a->is_array_of_tables())
+    fail(key, "must be an array of tables ([[" + key_path(key) + "]]), got " + type_name(*n));
+  for (std::size_t i = 0; i < a->size(); ++i)
+    out.emplace_back(*doc_, *a->get(i)->as_table(), key_path(key) + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+}  // namespace ncfsim::workflow

@@ -1,0 +1,89 @@
+#pragma once
+// Strict, typed reading of a TOML case file: every key read is recorded, so that after a case is
+// built any key nobody read is reported as unknown (with the closest known key as a hint). Every
+// error is an InputError naming the file, the full key path and the allowed range.
+#include <array>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+namespace ncfsim::workflow {
+
+/// Allowed interval of a number; bounds are inclusive unless marked open.
+struct Range {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false, hi_open = false;
+  static Range positive() { return {0, std::numeric_limits<double>::infinity(), true, false}; }
+  static Range non_negative() { return {0, std::numeric_limits<double>::infinity(), false, false}; }
+  static Range closed(double a, double b) { return {a, b, false, false}; }
+  static Range open_closed(double a, double b) { return {a, b, true, false}; }
+  bool contains(double v) const;
+  std::string describe() const;
+};
+
+/// The parsed document: root table, file name and the set of keys read so far.
+class CaseDocument {
+ public:
+  /// Parses the file; applies `overrides` ("a.b.c=value", value in TOML syntax or a bare string).
+  static CaseDocument load(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+  const std::filesystem::path& file() const { return file_; }
+  const toml::table& root() const { return root_; }
+  void mark_read(const std::string& path) { read_.insert(path); }
+  /// Throws InputError for the first key in the file that was never read.
+  void check_unknown_keys() const;
+
+ private:
+  std::filesystem::path file_;
+  toml::table root_;
+  std::set<std::string> read_;
+};
+
+/// A view of one table of the document at `path` ("" = root, "mesh.block[2]").
+class TableReader {
+ public:
+  TableReader(CaseDocument& doc, const toml::table& table, std::string path);
+
+  const std::string& path() const { return path_; }
+  std::string key_path(std::string_view key) const;
+  bool has(std::string_view key) const { return table_.contains(key); }
+  [[noreturn]] void fail(std::string_view key, const std::string& message) const;
+
+  double number(std::string_view key, Range range) const;
+  double number(std::string_view key, double fallback, Range range) const;
+  std::int64_t integer(std::string_view key, std::int64_t lo, std::int64_t hi) const;
+  std::int64_t integer(std::string_view key, std::int64_t fallback, std::int64_t lo, std::int64_t hi) const;
+  bool boolean(std::string_view key, bool fallback) const;
+  std::string string(std::string_view key) const;
+  std::string string(std::string_view key, const std::string& fallback) const;
+  /// One of `choices`.
+  std::string choice(std::string_view key, const std::vector<std::string>& choices,
+                     const std::string& fallback) const;
+  std::array<double, 3> vec3(std::string_view key, Range component_range = {}) const;
+  std::array<double, 3> vec3_or(std::string_view key, std::array<double, 3> fallback,
+                                Range component_range = {}) const;
+  std::vector<double> numbers(std::string_view key, Range range, std::size_t min_size = 1) const;
+  std::vector<std::string> strings(std::string_view key) const;
+  std::optional<TableReader> table(std::string_view key) const;
+  TableReader required_table(std::string_view key) const;
+  /// Array of tables ([[key]]); empty when absent.
+  std::vector<TableReader> tables(std::string_view key) const;
+
+  /// A sub-reader over this table that treats `key` as read even if it is not looked at.
+  void mark(std::string_view key) const { doc_->mark_read(key_path(key)); }
+
+ private:
+  const toml::node& require(std::string_view key) const;
+  double as_number(std::string_view key, const toml::node& node) const;
+
+  CaseDocument* doc_;
+  const toml::table& table_;
+  std::string path_;
+};
+
+}  // namespace ncfsim::workflow

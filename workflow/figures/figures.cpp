@@ -1,0 +1,146 @@
+#include "workflow/figures/figures.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "fem/io/result_reader.hpp"
+#include "render.hpp"
+#include "workflow/run/run_output.hpp"
+
+namespace ncfsim::workflow {
+
+namespace {
+using json = nlohmann::json;
+
+json plot_json(const PlotSpec& p) {
+  return {{"name", p.name},       {"title", p.title},     {"x", p.x},
+          {"y", p.y},             {"x_scale", p.x_scale}, {"y_scale", p.y_scale},
+          {"x_label", p.x_label}, {"y_label", p.y_label}};
+}
+
+std::string fmt_time(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", t);
+  return buf;
+}
+
+render::CameraPreset camera(const std::string& c) {
+  if (c == "top") return render::CameraPreset::Top;
+  if (c == "front") return render::CameraPreset::Front;
+  return render::CameraPreset::Iso;
+}
+}  // namespace
+
+void write_figure_specs(const std::filesystem::path& dir, const EngineCase& ec) {
+  json plots = json::array(), pictures = json::array();
+  for (const auto& p : ec.plots) plots.push_back(plot_json(p));
+  // Defaults, unless the case declares a figure of the same name.
+  auto add_default = [&](const PlotSpec& p) {
+    for (const auto& q : ec.plots)
+      if (q.name == p.name) return;
+    plots.push_back(plot_json(p));
+  };
+  add_default(PlotSpec{"energy_balance", ec.name + ": energy balance", "time",
+                             {"kinetic_energy_J", "internal_energy_J", "hourglass_energy_J", "contact_energy_J",
+                              "damping_energy_J", "external_work_J", "total_energy_J"},
+                             1.0, 1.0, "time [s]", "energy [J]"});
+  for (const auto& t : ec.model.tools)
+    add_default(PlotSpec{t.name + "_force_displacement", ec.name + ": " + t.name + " force",
+                               t.name + "_displacement_m", {t.name + "_force_N"}, 1e3, 1.0,
+                               t.name + " displacement [mm]", t.name + " force [N]"});
+  for (const auto& p : ec.probes)
+    add_default(PlotSpec{p.name + "_displacement", ec.name + ": " + p.name + " displacement", "time",
+                               {p.name + "_displacement_x_m", p.name + "_displacement_y_m", p.name + "_displacement_z_m"},
+                               1.0, 1e3, "time [s]", "displacement [mm]"});
+  for (const auto& p : ec.pictures)
+    pictures.push_back({{"name", p.name}, {"field", p.field}, {"camera", p.camera}, {"title", p.title}});
+  if (ec.pictures.empty()) {
+    if (!ec.model.mesh.hexes.empty())
+      pictures.push_back({{"name", "final_von_mises"}, {"field", "von_mises_stress"}, {"camera", "iso"},
+                          {"title", ec.name + ": von Mises stress, final state"}});
+    pictures.push_back({{"name", "final_displacement"}, {"field", "displacement_magnitude"}, {"camera", "iso"},
+                        {"title", ec.name + ": displacement, final state"}});
+  }
+  write_file_atomically(dir / "figures.json", json{{"plots", plots}, {"pictures", pictures}}.dump(2) + "\n");
+}
+
+std::vector<std::filesystem::path> render_figures(const std::filesystem::path& dir, spdlog::logger& log) {
+  std::ifstream in(dir / "figures.json");
+  if (!in) throw std::runtime_error((dir / "figures.json").string() + " not found (is this a run's output folder?)");
+  const json spec = json::parse(in);
+  std::string why;
+  if (!render::offscreen_rendering_available(&why)) throw std::runtime_error("no off-screen rendering: " + why);
+  std::vector<std::filesystem::path> out;
+  std::filesystem::create_directories(dir / "figures");
+
+  if (std::filesystem::exists(dir / "history.csv")) {
+    const CsvTable h = read_csv(dir / "history.csv");
+    for (const auto& p : spec.at("plots")) {
+      const std::string name = p.at("name");
+      try {
+        render::CurvePlot plot;
+        plot.title = p.at("title");
+        plot.x_label = p.at("x_label");
+        plot.y_label = p.at("y_label");
+        const double xs = p.at("x_scale"), ys = p.at("y_scale");
+        auto x = h.column(p.at("x"));
+        for (double& v : x) v *= xs;
+        for (const auto& yname : p.at("y")) {
+          auto y = h.column(yname);
+          for (double& v : y) v *= ys;
+          plot.series.push_back({yname.get<std::string>(), x, y});
+        }
+        if (h.rows.size() < 2) throw std::runtime_error("fewer than 2 rows in history.csv");
+        const auto png = dir / "figures" / (name + ".png");
+        render::plot_curves_png(plot, png);
+        out.push_back(png);
+      } catch (const std::exception& e) {
+        log.warn("figure {} skipped: {}", name, e.what());
+      }
+    }
+  }
+
+  const auto h5 = dir / "results.h5";
+  if (!spec.at("pictures").empty() && std::filesystem::exists(h5)) {
+    fem::io::ResultReader reader(h5);
+    if (reader.n_frames() > 0) {
+      const auto frame = reader.frame(reader.n_frames() - 1);
+      const auto& m = reader.mesh();
+      render::RenderMesh rm;
+      rm.points = frame.coordinates;
+      rm.hex8 = m.hex8;
+      rm.bar2 = m.bar2;
+      for (const auto& f : frame.fields) {
+        if (f.name == "displacement") {
+          render::MeshField mag{"displacement_magnitude", "m", false, 1, {}};
+          for (std::size_t i = 0; i + 2 < f.values.size(); i += 3)
+            mag.values.push_back(std::sqrt(f.values[i] * f.values[i] + f.values[i + 1] * f.values[i + 1] +
+                                           f.values[i + 2] * f.values[i + 2]));
+          rm.fields.push_back(std::move(mag));
+        } else if (f.name == "von_mises_stress") {
+          rm.fields.push_back({"von_mises_stress", "Pa", true, 1, f.values});
+        }
+      }
+      for (const auto& p : spec.at("pictures")) {
+        const std::string name = p.at("name");
+        try {
+          render::MeshFigure fig;
+          fig.field = p.at("field") == "none" ? "" : p.at("field").get<std::string>();
+          fig.title = p.at("title").get<std::string>() + " (t = " + fmt_time(frame.time) + " s)";
+          fig.camera = camera(p.at("camera"));
+          const auto png = dir / "figures" / (name + ".png");
+          render::render_mesh_png(rm, fig, png);
+          out.push_back(png);
+        } catch (const std::exception& e) {
+          log.warn("figure {} skipped: {}", name, e.what());
+        }
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace ncfsim::workflow

@@ -1,0 +1,122 @@
+// ncfsim: the command line (docs/cli.md). Subcommands run, check, render, report.
+// Exit codes: 0 success, 1 other error (incl. an interrupted run), 2 bad input, 3 numerical failure.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "fem/errors.hpp"
+#include "fem/petsc_vector.hpp"
+#include "fem/solver.hpp"
+#include "workflow/case/engine_case.hpp"
+#include "workflow/figures/figures.hpp"
+#include "workflow/report/report.hpp"
+#include "workflow/run/engine_run.hpp"
+#include "workflow/version.hpp"
+
+namespace wf = ncfsim::workflow;
+
+namespace {
+
+int bad_input(const std::exception& e) {
+  std::fprintf(stderr, "ncfsim: bad input: %s\n", e.what());
+  return wf::kBadInput;
+}
+
+void require_output_folder(const std::filesystem::path& dir) {
+  if (!std::filesystem::is_directory(dir))
+    throw ncfsim::InputError(dir.string(), "", "not a folder (give the output folder of a run)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"ncfsim: meso-mechanical drape-to-failure simulation of stitched carbon fabric "
+               "(explicit finite elements)"};
+  app.set_version_flag("--version", std::string("ncfsim ") + wf::kVersion);
+  app.require_subcommand(1);
+  bool quiet = false, verbose = false;
+  app.add_flag("-q,--quiet", quiet, "Only warnings and errors on the console (log.txt keeps everything)");
+  app.add_flag("-v,--verbose", verbose, "Debug messages on the console and in log.txt");
+
+  std::string case_file, out_dir;
+  std::vector<std::string> overrides;
+  int ranks = 1;
+  double progress = 5.0;
+  auto* run = app.add_subcommand("run", "Run a case: writes summary.json, history.csv, log.txt, "
+                                        "results.h5/.xdmf and figures to the output folder");
+  run->add_option("case", case_file, "Case file (TOML)")->required();
+  run->add_option("-o,--output", out_dir, "Output folder (default results/<case name>)");
+  run->add_option("--set", overrides, "Override a case key: --set KEY=VALUE (repeatable), e.g. "
+                                      "--set mesh.resolution=coarse");
+  run->add_option("--np", ranks, "MPI ranks (default 1)")->check(CLI::Range(1, 1 << 20));
+  run->add_option("--progress-interval", progress, "Seconds between progress lines (default 5)")
+      ->check(CLI::PositiveNumber);
+
+  auto* check = app.add_subcommand("check", "Validate a case without running it (exit 0, or 2 with the "
+                                            "file, key and allowed range)");
+  check->add_option("case", case_file, "Case file (TOML)")->required();
+  check->add_option("--set", overrides, "Override a case key: --set KEY=VALUE (repeatable)");
+
+  std::string folder;
+  auto* render = app.add_subcommand("render", "(Re)draw the figures of a finished run (off-screen)");
+  render->add_option("outdir", folder, "Output folder of a run")->required();
+  auto* report = app.add_subcommand("report", "Write report.html for a finished run");
+  report->add_option("outdir", folder, "Output folder of a run")->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : wf::kBadInput;
+  }
+  const wf::Verbosity verbosity = quiet ? wf::Verbosity::Quiet : verbose ? wf::Verbosity::Verbose : wf::Verbosity::Normal;
+
+  try {
+    if (*check) {
+      auto ec = wf::load_engine_case(case_file, overrides);
+      // Building the solver checks what only the assembled model can show (massless nodes, steps).
+      ncfsim::fem::PetscSession petsc;
+      ncfsim::fem::ExplicitSolver probe(ec.model);
+      std::printf("%s: OK (case '%s', %zu nodes, %zu hexahedra, %zu bars, stable step %.4g s, about %.3g cycles)\n",
+                  case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(), probe.n_hexes(), probe.n_bars(),
+                  probe.time_step(), ec.model.time.end_time / probe.time_step());
+      return wf::kSuccess;
+    }
+    if (*run) {
+      auto ec = wf::load_engine_case(case_file, overrides);
+      ncfsim::fem::PetscSession petsc;
+      wf::RunOptions o;
+      o.out_dir = out_dir;
+      o.verbosity = verbosity;
+      o.overrides = overrides;
+      o.ranks = ranks;
+      o.progress_interval_s = progress;
+      return wf::run_engine_case(ec, o);
+    }
+    if (*render) {
+      require_output_folder(folder);
+      auto log = wf::make_run_logger({}, verbosity);
+      const auto pngs = wf::render_figures(folder, *log);
+      for (const auto& p : pngs) log->info("{}", p.string());
+      return pngs.empty() ? wf::kOtherError : wf::kSuccess;
+    }
+    if (*report) {
+      require_output_folder(folder);
+      wf::write_report(folder);
+      std::printf("%s\n", (std::filesystem::path(folder) / "report.html").c_str());
+      return wf::kSuccess;
+    }
+  } catch (const ncfsim::InputError& e) {
+    return bad_input(e);
+  } catch (const ncfsim::NumericalError& e) {
+    std::fprintf(stderr, "ncfsim: numerical failure: %s\n", e.what());
+    return wf::kNumericalFailure;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ncfsim: error: %s\n", e.what());
+    return wf::kOtherError;
+  }
+  return wf::kOtherError;
+}

@@ -1,0 +1,396 @@
+#include "workflow/run/engine_run.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <spdlog/logger.h>
+
+#include "fem/element_fields.hpp"
+#include "fem/errors.hpp"
+#include "fem/io/result_writers.hpp"
+#include "fem/solver.hpp"
+#include "workflow/figures/figures.hpp"
+#include "workflow/report/report.hpp"
+#include "workflow/version.hpp"
+
+namespace ncfsim::workflow {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using fem::V3;
+using json = nlohmann::json;
+
+std::string hms(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+  const auto s = static_cast<long>(seconds + 0.5);
+  if (s >= 3600) return fmt::format("{}:{:02}:{:02}", s / 3600, (s / 60) % 60, s % 60);
+  return fmt::format("{:02}:{:02}", s / 60, s % 60);
+}
+
+// Axis a tool reports its scalar force and displacement along: its motion direction.
+V3 tool_axis(const fem::RigidTool& t) {
+  if (t.motion.kind == fem::ToolMotion::Kind::Velocity && norm(t.motion.velocity) > 0) return normalized(t.motion.velocity);
+  if (t.motion.kind == fem::ToolMotion::Kind::Force) return t.motion.axis;
+  return t.surface.axis;
+}
+
+struct HistoryColumns {
+  std::vector<std::string> names;
+  void add(std::string n) { names.push_back(std::move(n)); }
+  void add_xyz(const std::string& prefix, const std::string& unit) {
+    for (const char* c : {"x", "y", "z"}) add(prefix + "_" + c + "_" + unit);
+  }
+};
+
+// Output mesh in the solver's block order, so element fields map one to one.
+fem::io::ResultMesh result_mesh(const fem::ExplicitSolver& s) {
+  fem::io::ResultMesh m;
+  m.points = s.model().mesh.coords;
+  m.part_names = s.model().mesh.part_names;
+  for (const auto& b : s.hex_blocks())
+    for (std::size_t e = 0; e < b.n; ++e) {
+      for (int I = 0; I < 8; ++I) m.hex8.push_back(b.conn[static_cast<std::size_t>(I) * b.n + e]);
+      m.hex_part.push_back(b.part);
+    }
+  for (const auto& b : s.bar_blocks())
+    for (std::size_t e = 0; e < b.n; ++e) {
+      m.bar2.push_back(b.conn[e]);
+      m.bar2.push_back(b.conn[b.n + e]);
+      m.bar_part.push_back(b.part);
+    }
+  return m;
+}
+
+fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
+  fem::io::Frame fr;
+  fr.time = s.time();
+  fr.cycle = static_cast<int>(s.cycle());
+  const std::size_t nn = s.model().mesh.n_nodes();
+  auto X = s.x.view();
+  auto X0 = s.x0.view();
+  auto Vv = s.v.view();
+  fr.displacement.resize(3 * nn);
+  for (std::size_t d = 0; d < 3 * nn; ++d) fr.displacement[d] = X[d] - X0[d];
+  fr.fields.push_back({"velocity", false, 3, std::vector<double>(Vv.data(), Vv.data() + 3 * nn)});
+  const std::size_t nh = s.n_hexes(), nb = s.n_bars();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  fem::io::FrameField stress{"stress", true, 6, std::vector<double>(6 * (nh + nb), nan)};
+  fem::io::FrameField vm{"von_mises_stress", true, 1, std::vector<double>(nh + nb, nan)};
+  fem::io::FrameField fibre{"fibre_direction", true, 3, std::vector<double>(3 * (nh + nb), nan)};
+  fem::io::FrameField axial{"axial_force", true, 1, std::vector<double>(nh + nb, nan)};
+  fem::io::FrameField bstrain{"axial_strain", true, 1, std::vector<double>(nh + nb, nan)};
+  std::size_t off = 0;
+  for (const auto& b : s.hex_blocks()) {
+    fem::hex8_output_fields(b, X.data(), stress.values.data() + 6 * off, vm.values.data() + off,
+                            fibre.values.data() + 3 * off);
+    off += b.n;
+  }
+  for (const auto& b : s.bar_blocks()) {
+    for (std::size_t e = 0; e < b.n; ++e) {
+      axial.values[off + e] = b.force[e];
+      bstrain.values[off + e] = b.strain[e];
+    }
+    off += b.n;
+  }
+  if (nh) {
+    fr.fields.push_back(std::move(stress));
+    fr.fields.push_back(std::move(vm));
+    fr.fields.push_back(std::move(fibre));
+  }
+  if (nb) {
+    fr.fields.push_back(std::move(axial));
+    fr.fields.push_back(std::move(bstrain));
+  }
+  return fr;
+}
+
+void clean_previous_results(const std::filesystem::path& dir) {
+  for (const char* f : {"results.h5", "results.xdmf", "results.pvd", "history.csv", "summary.json",
+                        "report.html", "figures.json", "case.toml", "log.txt"})
+    std::filesystem::remove(dir / f);
+  std::filesystem::remove_all(dir / "frames");
+  std::filesystem::remove_all(dir / "figures");
+}
+
+}  // namespace
+
+std::filesystem::path output_folder(const EngineCase& ec, const RunOptions& o) {
+  return o.out_dir.empty() ? std::filesystem::path("results") / ec.name : o.out_dir;
+}
+
+int run_engine_case(EngineCase& ec, const RunOptions& options) {
+  const auto wall0 = Clock::now();
+  const std::filesystem::path dir = output_folder(ec, options);
+  std::filesystem::create_directories(dir);
+  clean_previous_results(dir);
+  auto log = make_run_logger(dir, options.verbosity);
+  std::filesystem::copy_file(ec.file, dir / "case.toml", std::filesystem::copy_options::overwrite_existing);
+  write_figure_specs(dir, ec);
+
+  log->info("ncfsim {} | case '{}' ({}) | resolution {}", kVersion, ec.name, ec.file.string(), ec.resolution);
+  if (!ec.description.empty()) log->info("  {}", ec.description);
+  for (const auto& ov : options.overrides) log->info("  --set {}", ov);
+  if (options.ranks > 1)
+    log->warn("--np {}: this build runs the engine on one rank; the state is laid out for MPI "
+              "(ghosted PETSc vectors) but the domain decomposition is not implemented yet",
+              options.ranks);
+
+  json summary;
+  summary["case"] = ec.name;
+  summary["stage"] = "engine";
+  summary["ncfsim_version"] = kVersion;
+  summary["case_file"] = ec.file.string();
+  summary["overrides"] = options.overrides;
+  summary["resolution"] = ec.resolution;
+  summary["status"] = "starting";
+  auto write_summary = [&] { write_file_atomically(dir / "summary.json", summary.dump(2) + "\n"); };
+
+  std::unique_ptr<fem::ExplicitSolver> solver_ptr;
+  try {
+    solver_ptr = std::make_unique<fem::ExplicitSolver>(ec.model);
+  } catch (const InputError& e) {
+    summary["status"] = "bad_input";
+    summary["error"] = e.what();
+    write_summary();
+    throw InputError(ec.file.string(), e.key(), std::string(e.what()));
+  }
+  fem::ExplicitSolver& solver = *solver_ptr;
+  const fem::Model& model = solver.model();
+
+  log->info("mesh: {} nodes, {} hexahedra, {} bars, {} parts, {} tools", model.mesh.n_nodes(),
+            solver.n_hexes(), solver.n_bars(), model.mesh.part_names.size(), model.tools.size());
+  const auto& st = solver.controlling_element();
+  log->info("stable step {:.4g} s (safety factor {}), controlled by {} {}", solver.time_step(),
+            model.time.safety_factor, st.is_bar ? "bar" : "hexahedron", st.element);
+  json parts = json::object();
+  for (const auto& pm : solver.part_masses()) {
+    const double pct = pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0;
+    log->info("  part {:<16} mass {:.5g} kg, added by mass scaling {:.5g} kg ({:.3g} %)", pm.part, pm.mass,
+              pm.added_mass, pct);
+    parts[pm.part] = {{"mass_kg", pm.mass}, {"added_mass_kg", pm.added_mass}, {"added_mass_percent", pct}};
+  }
+  const double est_cycles = model.time.end_time / solver.time_step();
+  log->info("end time {:.4g} s: about {:.3g} cycles", model.time.end_time, est_cycles);
+
+  summary["elements"] = {{"hex8", solver.n_hexes()}, {"bar2", solver.n_bars()}};
+  summary["nodes"] = model.mesh.n_nodes();
+  summary["parts"] = parts;
+  summary["end_time_s"] = model.time.end_time;
+  summary["time_step_initial_s"] = solver.time_step();
+  summary["energy_balance_limit"] = model.time.energy_balance_limit;
+
+  // History columns.
+  HistoryColumns hc;
+  for (const char* c : {"time", "cycle", "time_step_s", "kinetic_energy_J", "internal_energy_J",
+                        "stabilisation_energy_J", "hourglass_energy_J", "contact_energy_J",
+                        "friction_energy_J", "damping_energy_J", "external_work_J", "total_energy_J",
+                        "energy_balance_error"})
+    hc.add(c);
+  for (const auto& t : model.tools) {
+    hc.add(t.name + "_force_N");
+    hc.add(t.name + "_displacement_m");
+    hc.add_xyz(t.name + "_force", "N");
+    hc.add_xyz(t.name + "_displacement", "m");
+  }
+  for (const auto& r : ec.reactions) hc.add_xyz(r.name + "_reaction", "N");
+  for (const auto& p : ec.probes) hc.add_xyz(p.name + "_displacement", "m");
+  HistoryWriter history(dir / "history.csv", hc.names);
+
+  auto probe_disp = [&](const std::vector<std::int32_t>& nodes) {
+    auto X = solver.x.view();
+    auto X0 = solver.x0.view();
+    V3 s;
+    for (auto i : nodes) {
+      const auto k = 3 * static_cast<std::size_t>(i);
+      s += V3{X[k] - X0[k], X[k + 1] - X0[k + 1], X[k + 2] - X0[k + 2]};
+    }
+    return (1.0 / static_cast<double>(nodes.size())) * s;
+  };
+  double max_error = 0;
+  auto history_row = [&] {
+    const auto& en = solver.energy();
+    std::vector<double> row{solver.time(), static_cast<double>(solver.cycle()), solver.time_step(),
+                            en.kinetic, en.internal, en.stabilisation, en.hourglass, en.contact,
+                            en.friction, en.damping, en.external_work, en.total(), en.error()};
+    for (const auto& t : model.tools) {
+      const V3 ax = tool_axis(t);
+      row.push_back(-dot(t.force, ax));  // resistance of the part, positive against the motion
+      row.push_back(dot(t.displacement, ax));
+      for (double v : t.force.arr()) row.push_back(v);
+      for (double v : t.displacement.arr()) row.push_back(v);
+    }
+    for (const auto& r : ec.reactions)
+      for (double v : solver.reaction_force(r.nodes).arr()) row.push_back(v);
+    for (const auto& p : ec.probes)
+      for (double v : probe_disp(p.nodes).arr()) row.push_back(v);
+    history.write_row(row);
+  };
+
+  // Frames.
+  std::unique_ptr<fem::io::XdmfResultWriter> xdmf;
+  std::unique_ptr<fem::io::VtuSeriesWriter> vtu;
+  const fem::io::ResultMesh rmesh = result_mesh(solver);
+  if (ec.output.xdmf) xdmf = std::make_unique<fem::io::XdmfResultWriter>(dir, rmesh);
+  if (ec.output.vtu) vtu = std::make_unique<fem::io::VtuSeriesWriter>(dir, rmesh);
+  std::size_t frames = 0;
+  auto write_frame = [&] {
+    if (!xdmf && !vtu) return;
+    const fem::io::Frame fr = make_frame(solver);
+    if (xdmf) xdmf->write_frame(fr);
+    if (vtu) vtu->write_frame(fr);
+    ++frames;
+  };
+
+  // The loop.
+  const auto& tc = model.time;
+  double next_history = 0, next_frame = 0;
+  auto last_progress = Clock::now();
+  std::string status = "completed";
+  std::string failure;
+  bool exceeded_reported = false;
+  StopRequest::install();
+  summary["status"] = "running";
+  write_summary();
+
+  auto fill_summary = [&] {
+    const auto& en = solver.energy();
+    summary["status"] = status;
+    summary["wall_seconds"] = std::chrono::duration<double>(Clock::now() - wall0).count();
+    summary["cycles"] = solver.cycle();
+    summary["time_reached_s"] = solver.time();
+    summary["time_step_final_s"] = solver.time_step();
+    summary["frames"] = frames;
+    summary["energy_balance_error"] = en.error();
+    summary["energy_balance_error_max"] = max_error;
+    summary["kinetic_energy_J"] = en.kinetic;
+    summary["internal_energy_J"] = en.internal;
+    summary["stabilisation_energy_J"] = en.stabilisation;
+    summary["hourglass_energy_J"] = en.hourglass;
+    summary["contact_energy_J"] = en.contact;
+    summary["friction_energy_J"] = en.friction;
+    summary["damping_energy_J"] = en.damping;
+    summary["external_work_J"] = en.external_work;
+    summary["hourglass_to_internal_ratio"] = en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
+    for (const auto& t : model.tools) {
+      summary[t.name + "_force_N"] = -dot(t.force, tool_axis(t));
+      summary[t.name + "_displacement_m"] = dot(t.displacement, tool_axis(t));
+    }
+    for (const auto& p : ec.probes) {
+      const V3 d = probe_disp(p.nodes);
+      summary[p.name + "_displacement_m"] = {d.x, d.y, d.z};
+    }
+    const auto& tm = solver.timers();
+    summary["timers_s"] = {{"internal_force", tm.internal_force}, {"contact", tm.contact},
+                           {"update", tm.update}, {"output", tm.output}};
+    if (!failure.empty()) summary["error"] = failure;
+  };
+
+  int exit_code = kSuccess;
+  try {
+    while (solver.time() < tc.end_time * (1 - 1e-12)) {
+      if (tc.max_cycles > 0 && solver.cycle() >= tc.max_cycles) {
+        status = "max_cycles";
+        log->warn("stopped at the cycle limit time.max_cycles = {}", tc.max_cycles);
+        break;
+      }
+      if (StopRequest::requested()) {
+        status = "interrupted";
+        log->warn("interrupted at t = {:.6g} s, cycle {}: writing the last frame and summary", solver.time(),
+                  solver.cycle());
+        break;
+      }
+      solver.step([&] {
+        const double t = solver.time();
+        const double err = solver.energy().error();
+        if (t > 0.05 * tc.end_time) max_error = std::max(max_error, err);  // skip the start, when little energy is in play
+        if (t >= next_history) {
+          history_row();
+          next_history += tc.history_interval;
+          if (!exceeded_reported && err > tc.energy_balance_limit && t > 0.05 * tc.end_time) {
+            log->warn("energy balance error {:.3g} % passed its limit {:.3g} % at t = {:.6g} s", 100 * err,
+                      100 * tc.energy_balance_limit, t);
+            exceeded_reported = true;
+          }
+        }
+        if (t >= next_frame) {
+          write_frame();
+          fill_summary();
+          summary["status"] = "running";
+          write_summary();
+          next_frame += tc.frame_interval;
+        }
+        const auto now = Clock::now();
+        if (std::chrono::duration<double>(now - last_progress).count() >= options.progress_interval_s) {
+          last_progress = now;
+          const double wall = std::chrono::duration<double>(now - wall0).count();
+          const double frac = t / tc.end_time;
+          log->info("t = {:.4e} / {:.4e} s ({:4.1f} %) | cycle {} | dt {:.3e} s | wall {} | ETA {} | "
+                    "energy balance {:.3f} %",
+                    t, tc.end_time, 100 * frac, solver.cycle(), solver.time_step(), hms(wall),
+                    frac > 0 ? hms(wall * (1 - frac) / frac) : "--:--", 100 * err);
+        }
+      });
+    }
+    // Final state (positions at the end time; forces of the last cycle).
+    history_row();
+    write_frame();
+  } catch (const NumericalError& e) {
+    status = "numerical_failure";
+    failure = e.what();
+    log->error("{}", e.what());
+    exit_code = kNumericalFailure;
+  }
+  if (xdmf) xdmf->close();
+  if (vtu) vtu->close();
+
+  const double err = solver.energy().error();
+  if (exit_code == kSuccess && err > tc.energy_balance_limit) {
+    status = "energy_balance_exceeded";
+    failure = fmt::format("energy balance error {:.3g} % is past its limit {:.3g} % (time.energy_balance_limit)",
+                          100 * err, 100 * tc.energy_balance_limit);
+    log->error("{}", failure);
+    exit_code = kNumericalFailure;
+  }
+  if (exit_code == kSuccess && status == "interrupted") exit_code = kOtherError;
+  fill_summary();
+  write_summary();
+
+  const auto& en = solver.energy();
+  log->info("energy balance at t = {:.6g} s: kinetic {:.5g} J, internal {:.5g} J (stabilisation {:.5g} J), "
+            "hourglass {:.5g} J, contact {:.5g} J (friction {:.5g} J), damping {:.5g} J, external work "
+            "{:.5g} J, error {:.3g} % (limit {:.3g} %)",
+            en.time, en.kinetic, en.internal, en.stabilisation, en.hourglass, en.contact, en.friction, en.damping,
+            en.external_work, 100 * err, 100 * tc.energy_balance_limit);
+  const auto& tm = solver.timers();
+  const double elem_cycles = static_cast<double>(solver.cycle()) * static_cast<double>(solver.n_hexes() + solver.n_bars());
+  log->info("{} cycles in {} | internal force {:.3g} s ({:.0f} ns per element-cycle), contact {:.3g} s, "
+            "update {:.3g} s, output {:.3g} s",
+            solver.cycle(), hms(summary["wall_seconds"].get<double>()), tm.internal_force,
+            elem_cycles > 0 ? 1e9 * tm.internal_force / elem_cycles : 0.0, tm.contact, tm.update, tm.output);
+
+  if (ec.output.figures) {
+    try {
+      const auto written = render_figures(dir, *log);
+      log->info("{} figures in {}", written.size(), (dir / "figures").string());
+    } catch (const std::exception& e) {
+      log->warn("figures not drawn: {}", e.what());
+    }
+  }
+  if (ec.output.report) {
+    try {
+      write_report(dir);
+      log->info("report: {}", (dir / "report.html").string());
+    } catch (const std::exception& e) {
+      log->warn("report not written: {}", e.what());
+    }
+  }
+  log->info("results in {} (status: {})", dir.string(), status);
+  return exit_code;
+}
+
+}  // namespace ncfsim::workflow
