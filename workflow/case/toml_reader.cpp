@@ -150,6 +150,11 @@ void CaseDocument::check_unknown_keys() const {
       const std::size_t d = edit_distance(g, k);
       if (d < best) best = d, hint = k;
     }
+    if (!hint.empty()) {  // show the hint with this key's own table path
+      const auto dot_leaf = leaf.rfind('.'), dot_hint = hint.rfind('.');
+      const std::string tail = dot_hint == std::string::npos ? hint : hint.substr(dot_hint + 1);
+      hint = dot_leaf == std::string::npos ? tail : leaf.substr(0, dot_leaf + 1) + tail;
+    }
     throw InputError(file_.string(), leaf,
                      "unknown key" + (hint.empty() ? std::string(" (see docs/case-file.md)")
                                                    : " (did you mean '" + hint + "'?)"));

@@ -1,0 +1,203 @@
+// The ncfsim command line end to end: bad input gives exit code 2 and names the key; the
+// cantilever verification case runs to Euler-Bernoulli through the CLI (regression); an
+// interrupted run leaves readable results; the report references its figures by relative path.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "fem/io/result_reader.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kExe = NCFSIM_EXE;
+const fs::path kSource = NCFSIM_SOURCE_DIR;
+
+struct Result {
+  int code = -1;
+  std::string output;  // stdout + stderr
+};
+
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    ::unsetenv("DISPLAY");
+    std::vector<char*> argv;
+    std::string exe = kExe.string();
+    argv.push_back(exe.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(exe.c_str(), argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+int wait_code(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+Result run_cli(const std::vector<std::string>& args) {
+  const fs::path log = fs::temp_directory_path() / ("ncfsim_cli_" + std::to_string(getpid()) + ".log");
+  Result r;
+  r.code = wait_code(spawn(args, log));
+  r.output = slurp(log);
+  fs::remove(log);
+  return r;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("ncfsim_test_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+}  // namespace
+
+struct BadCase {
+  const char* file;
+  const char* key;
+};
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.file; }
+
+class BadInput : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadInput, ExitCodeTwoNamingTheKey) {
+  const fs::path file = kSource / "tests/cases/bad" / GetParam().file;
+  for (const char* cmd : {"check", "run"}) {
+    const fs::path out = fresh_dir("bad");
+    std::vector<std::string> args{cmd, file.string()};
+    if (std::string(cmd) == "run") args.insert(args.end(), {"-o", out.string()});
+    const Result r = run_cli(args);
+    EXPECT_EQ(r.code, 2) << cmd << ": " << r.output;
+    EXPECT_NE(r.output.find(std::string("'") + GetParam().key + "'"), std::string::npos)
+        << cmd << " should name the key " << GetParam().key << ": " << r.output;
+    EXPECT_NE(r.output.find(file.filename().string()), std::string::npos) << "should name the file";
+    EXPECT_FALSE(fs::exists(out)) << "bad input must not leave a half-written output folder";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(MalformedCases, BadInput,
+                         ::testing::Values(BadCase{"unknown_key.toml", "material[0].youngs_modulos"},
+                                           BadCase{"negative_modulus.toml", "material[0].youngs_modulus"},
+                                           BadCase{"missing_mesh.toml", "mesh"},
+                                           BadCase{"wrong_type.toml", "time.end_time"},
+                                           BadCase{"zero_density.toml", "material[0].density"}),
+                         [](const ::testing::TestParamInfo<BadCase>& info) {
+                           const std::string f = info.param.file;
+                           return f.substr(0, f.find('.'));
+                         });
+
+TEST(Cli, SetOverridesAreCheckedLikeTheFile) {
+  const fs::path c = kSource / "cases/verification/cantilever.toml";
+  Result r = run_cli({"check", c.string(), "--set", "time.end_tme=1"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("time.end_tme"), std::string::npos) << r.output;
+  r = run_cli({"check", c.string(), "--set", "mesh.resolution=medium"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("'coarse'"), std::string::npos) << "should list the allowed values: " << r.output;
+  r = run_cli({"check", c.string(), "--set", "mesh.resolution=coarse"});
+  EXPECT_EQ(r.code, 0) << r.output;
+}
+
+// Regression: the default case through the CLI reproduces Euler-Bernoulli within 5 %.
+TEST(CliRegression, CantileverCaseMatchesEulerBernoulli) {
+  const fs::path out = fresh_dir("cantilever");
+  const Result r = run_cli({"run", (kSource / "cases/verification/cantilever.toml").string(), "-o", out.string(),
+                           "--set", "mesh.resolution=coarse"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_EQ(s["status"], "completed");
+  EXPECT_EQ(s["case"], "cantilever");
+  EXPECT_EQ(s["elements"]["hex8"], 10);
+  const double L = 0.2, h = 0.01, E = 200e9, P = 50, I = h * h * h * h / 12;
+  const double analytic = P * L * L * L / (3 * E * I);
+  const double tip = -s["tip_displacement_m"][1].get<double>();
+  EXPECT_NEAR(tip, analytic, 0.05 * analytic);
+  EXPECT_LT(s["energy_balance_error"].get<double>(), 0.01);
+  EXPECT_LT(s["hourglass_to_internal_ratio"].get<double>(), 0.10);
+  for (const char* f : {"history.csv", "log.txt", "results.h5", "results.xdmf", "report.html"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const std::string header = slurp(out / "history.csv").substr(0, 200);
+  EXPECT_EQ(header.rfind("time,cycle,time_step_s,kinetic_energy_J,internal_energy_J", 0), 0u) << header;
+  // The log holds what the console showed.
+  EXPECT_NE(slurp(out / "log.txt").find("energy balance at t ="), std::string::npos);
+  // The report references existing figures by relative path.
+  const std::string html = slurp(out / "report.html");
+  std::smatch m;
+  std::string rest = html;
+  int images = 0;
+  while (std::regex_search(rest, m, std::regex("<img src=\"([^\"]+)\""))) {
+    EXPECT_TRUE(fs::path(m[1].str()).is_relative()) << m[1];
+    EXPECT_TRUE(fs::exists(out / m[1].str())) << m[1];
+    ++images;
+    rest = m.suffix();
+  }
+  EXPECT_GE(images, 3) << "energy balance, tip displacement and the deformed shape";
+  fs::remove_all(out);
+}
+
+// SIGINT stops a run after the current cycle; results.h5/.xdmf and summary.json stay readable.
+TEST(CliRegression, InterruptedRunLeavesReadableResults) {
+  const fs::path out = fresh_dir("sigint");
+  const fs::path log = out.string() + ".log";
+  const pid_t pid = spawn({"run", (kSource / "cases/verification/cantilever.toml").string(), "-o", out.string(),
+                           "--set", "time.end_time=100.0", "--set", "time.frame_interval=1e-3",
+                           "--set", "output.figures=false", "--set", "output.report=false"},
+                          log);
+  // Wait until a few frames are out.
+  bool ready = false;
+  for (int i = 0; i < 600 && !ready; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (fs::exists(out / "results.h5")) {
+      try {
+        ready = ncfsim::fem::io::ResultReader(out / "results.h5").n_frames() >= 3;
+      } catch (const std::exception&) {
+      }
+    }
+  }
+  ASSERT_TRUE(ready) << slurp(log);
+  kill(pid, SIGINT);
+  const int code = wait_code(pid);
+  EXPECT_EQ(code, 1) << "an interrupted run ends with exit code 1: " << slurp(log);
+  const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_EQ(s["status"], "interrupted");
+  EXPECT_LT(s["time_reached_s"].get<double>(), 100.0);
+  ncfsim::fem::io::ResultReader reader(out / "results.h5");
+  ASSERT_GE(reader.n_frames(), 3u);
+  const auto last = reader.frame(reader.n_frames() - 1);
+  EXPECT_EQ(last.coordinates.size(), reader.mesh().points.size());
+  const std::string xdmf = slurp(out / "results.xdmf");
+  std::size_t times = 0;
+  for (std::size_t p = xdmf.find("<Time "); p != std::string::npos; p = xdmf.find("<Time ", p + 1)) ++times;
+  EXPECT_EQ(times, reader.n_frames()) << "every frame named by the XDMF is in the HDF5 file";
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_NE(e.path().extension(), ".tmp") << "left a temporary file: " << e.path();
+  fs::remove_all(out);
+  fs::remove(log);
+}
