@@ -391,14 +391,36 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       p.y_scale = t.number("y_scale", 1.0, {});
       p.x_label = t.string("x_label", p.x);
       p.y_label = t.string("y_label", p.y.empty() ? "" : p.y.front());
+      for (const auto& it : t.tables("import")) {
+        ImportedSeries is;
+        is.file = it.string("file");
+        if (is.file.is_relative()) is.file = std::filesystem::absolute(file.parent_path() / is.file);
+        if (!std::filesystem::exists(is.file)) it.fail("file", "no such file: " + is.file.string());
+        is.x = it.string("x");
+        is.y = it.string("y");
+        is.label = it.string("label", is.file.stem().string());
+        is.x_scale = it.number("x_scale", 1.0, {});
+        is.y_scale = it.number("y_scale", 1.0, {});
+        p.imports.push_back(std::move(is));
+      }
+      for (const auto& rt : t.tables("reference"))
+        p.references.push_back({rt.string("label"), rt.number("y", {})});
       ec.plots.push_back(std::move(p));
     }
     for (const auto& t : f->tables("picture")) {
       PictureSpec p;
       p.name = t.string("name");
-      p.field = t.choice("field", {"displacement_magnitude", "von_mises_stress", "none"}, "displacement_magnitude");
+      p.field = t.choice("field",
+                         {"displacement_magnitude", "displacement", "velocity", "stress", "von_mises_stress",
+                          "fibre_direction", "axial_force", "axial_strain", "none"},
+                         "displacement_magnitude");
+      p.component = static_cast<int>(t.integer("component", -1, -1, 5));
       p.camera = t.choice("camera", {"iso", "top", "front"}, "iso");
       p.title = t.string("title", "");
+      p.follow_part = t.string("follow_part", "");
+      if (!p.follow_part.empty() && mesh.find_part(p.follow_part) < 0)
+        t.fail("follow_part", "no part named '" + p.follow_part + "'");
+      p.deformation_scale = t.number("deformation_scale", 1.0, Range::non_negative());
       ec.pictures.push_back(std::move(p));
     }
   }

@@ -30,6 +30,20 @@ struct OutputSettings {
 };
 
 /// A curve plot from history.csv: y columns against an x column.
+/// A curve from another CSV (test data, a macro shell result), drawn dashed beside the run's.
+struct ImportedSeries {
+  std::string label;
+  std::filesystem::path file;       // absolute, resolved against the case file's folder
+  std::string x, y;                 // column names
+  double x_scale = 1.0, y_scale = 1.0;
+};
+
+/// A horizontal reference line (an analytic value), drawn dashed.
+struct ReferenceLine {
+  std::string label;
+  double y = 0;                     // in plotted units (after y_scale)
+};
+
 struct PlotSpec {
   std::string name;                 // file figures/<name>.png
   std::string title;
@@ -37,14 +51,19 @@ struct PlotSpec {
   std::vector<std::string> y;       // column names
   double x_scale = 1.0, y_scale = 1.0;
   std::string x_label, y_label;
+  std::vector<ImportedSeries> imports;
+  std::vector<ReferenceLine> references;
 };
 
 /// A picture of the last frame coloured by a field.
 struct PictureSpec {
   std::string name;
-  std::string field;   // displacement_magnitude, von_mises_stress, ... (docs/output.md)
-  std::string camera;  // iso | top | front
+  std::string field;        // a frame field (docs/output.md) or displacement_magnitude; "none"
+  int component = -1;       // -1: magnitude of a vector/tensor field
+  std::string camera;       // iso | top | front
   std::string title;
+  std::string follow_part;  // the camera fits this part's current bounds ("" = whole model)
+  double deformation_scale = 1.0;
 };
 
 struct EngineCase {

@@ -16,9 +16,23 @@ namespace {
 using json = nlohmann::json;
 
 json plot_json(const PlotSpec& p) {
+  json imports = json::array(), refs = json::array();
+  for (const auto& i : p.imports)
+    imports.push_back({{"label", i.label}, {"file", i.file.string()}, {"x", i.x}, {"y", i.y},
+                       {"x_scale", i.x_scale}, {"y_scale", i.y_scale}});
+  for (const auto& r : p.references) refs.push_back({{"label", r.label}, {"y", r.y}});
   return {{"name", p.name},       {"title", p.title},     {"x", p.x},
           {"y", p.y},             {"x_scale", p.x_scale}, {"y_scale", p.y_scale},
-          {"x_label", p.x_label}, {"y_label", p.y_label}};
+          {"x_label", p.x_label}, {"y_label", p.y_label}, {"imports", imports},
+          {"references", refs}};
+}
+
+std::string unit_of(const std::string& field) {
+  if (field == "stress" || field == "von_mises_stress") return "Pa";
+  if (field == "displacement" || field == "displacement_magnitude") return "m";
+  if (field == "velocity") return "m/s";
+  if (field == "axial_force") return "N";
+  return "-";
 }
 
 std::string fmt_time(double t) {
@@ -46,17 +60,19 @@ void write_figure_specs(const std::filesystem::path& dir, const EngineCase& ec) 
   add_default(PlotSpec{"energy_balance", ec.name + ": energy balance", "time",
                              {"kinetic_energy_J", "internal_energy_J", "hourglass_energy_J", "contact_energy_J",
                               "damping_energy_J", "external_work_J", "total_energy_J"},
-                             1.0, 1.0, "time [s]", "energy [J]"});
+                             1.0, 1.0, "time [s]", "energy [J]", {}, {}});
   for (const auto& t : ec.model.tools)
     add_default(PlotSpec{t.name + "_force_displacement", ec.name + ": " + t.name + " force",
                                t.name + "_displacement_m", {t.name + "_force_N"}, 1e3, 1.0,
-                               t.name + " displacement [mm]", t.name + " force [N]"});
+                               t.name + " displacement [mm]", t.name + " force [N]", {}, {}});
   for (const auto& p : ec.probes)
     add_default(PlotSpec{p.name + "_displacement", ec.name + ": " + p.name + " displacement", "time",
                                {p.name + "_displacement_x_m", p.name + "_displacement_y_m", p.name + "_displacement_z_m"},
-                               1.0, 1e3, "time [s]", "displacement [mm]"});
+                               1.0, 1e3, "time [s]", "displacement [mm]", {}, {}});
   for (const auto& p : ec.pictures)
-    pictures.push_back({{"name", p.name}, {"field", p.field}, {"camera", p.camera}, {"title", p.title}});
+    pictures.push_back({{"name", p.name}, {"field", p.field}, {"component", p.component}, {"camera", p.camera},
+                        {"title", p.title}, {"follow_part", p.follow_part},
+                        {"deformation_scale", p.deformation_scale}});
   if (ec.pictures.empty()) {
     if (!ec.model.mesh.hexes.empty())
       pictures.push_back({{"name", "final_von_mises"}, {"field", "von_mises_stress"}, {"camera", "iso"},
@@ -94,6 +110,21 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
           plot.series.push_back({yname.get<std::string>(), x, y});
         }
         if (h.rows.size() < 2) throw std::runtime_error("fewer than 2 rows in history.csv");
+        for (const auto& im : p.value("imports", json::array())) {
+          const CsvTable t = read_csv(im.at("file").get<std::string>());
+          auto ix = t.column(im.at("x")), iy = t.column(im.at("y"));
+          for (double& v : ix) v *= im.at("x_scale").get<double>();
+          for (double& v : iy) v *= im.at("y_scale").get<double>();
+          render::CurveSeries cs{im.at("label"), ix, iy};
+          cs.dashed = true;
+          plot.series.push_back(std::move(cs));
+        }
+        for (const auto& r : p.value("references", json::array())) {
+          const double y = r.at("y");
+          render::CurveSeries cs{r.at("label"), {x.front(), x.back()}, {y, y}};
+          cs.dashed = true;
+          plot.series.push_back(std::move(cs));
+        }
         const auto png = dir / "figures" / (name + ".png");
         render::plot_curves_png(plot, png);
         out.push_back(png);
@@ -110,7 +141,6 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
       const auto frame = reader.frame(reader.n_frames() - 1);
       const auto& m = reader.mesh();
       render::RenderMesh rm;
-      rm.points = frame.coordinates;
       rm.hex8 = m.hex8;
       rm.bar2 = m.bar2;
       for (const auto& f : frame.fields) {
@@ -120,16 +150,41 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
             mag.values.push_back(std::sqrt(f.values[i] * f.values[i] + f.values[i + 1] * f.values[i + 1] +
                                            f.values[i + 2] * f.values[i + 2]));
           rm.fields.push_back(std::move(mag));
-        } else if (f.name == "von_mises_stress") {
-          rm.fields.push_back({"von_mises_stress", "Pa", true, 1, f.values});
         }
+        rm.fields.push_back({f.name, unit_of(f.name), f.on_cells, f.n_components, f.values});
       }
       for (const auto& p : spec.at("pictures")) {
         const std::string name = p.at("name");
         try {
+          // Deformed shape, displacements scaled for visibility where asked.
+          const double scale = p.value("deformation_scale", 1.0);
+          rm.points.resize(m.points.size());
+          for (std::size_t i = 0; i < m.points.size(); ++i)
+            rm.points[i] = m.points[i] + scale * (frame.coordinates[i] - m.points[i]);
           render::MeshFigure fig;
           fig.field = p.at("field") == "none" ? "" : p.at("field").get<std::string>();
-          fig.title = p.at("title").get<std::string>() + " (t = " + fmt_time(frame.time) + " s)";
+          fig.component = p.value("component", -1);
+          const std::string follow = p.value("follow_part", "");
+          if (!follow.empty()) {
+            int part = -1;
+            for (std::size_t k = 0; k < m.part_names.size(); ++k)
+              if (m.part_names[k] == follow) part = static_cast<int>(k);
+            std::array<double, 6> b{1e300, -1e300, 1e300, -1e300, 1e300, -1e300};
+            auto grow = [&](std::int64_t node) {
+              for (int c = 0; c < 3; ++c) {
+                const double v = rm.points[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)];
+                b[2 * c] = std::min(b[2 * c], v), b[2 * c + 1] = std::max(b[2 * c + 1], v);
+              }
+            };
+            for (std::size_t e = 0; e < m.hex_part.size(); ++e)
+              if (m.hex_part[e] == part)
+                for (int I = 0; I < 8; ++I) grow(m.hex8[8 * e + static_cast<std::size_t>(I)]);
+            for (std::size_t e = 0; e < m.bar_part.size(); ++e)
+              if (m.bar_part[e] == part) grow(m.bar2[2 * e]), grow(m.bar2[2 * e + 1]);
+            if (b[0] <= b[1]) fig.focus_bounds = b;
+          }
+          fig.title = p.at("title").get<std::string>() + " (t = " + fmt_time(frame.time) + " s" +
+                      (scale != 1.0 ? ", displacements x" + fmt_time(scale) : std::string()) + ")";
           fig.camera = camera(p.at("camera"));
           const auto png = dir / "figures" / (name + ".png");
           render::render_mesh_png(rm, fig, png);

@@ -466,7 +466,8 @@ vtkSmartPointer<vtkDoubleArray> make_array(const std::string& name, const double
   return a;
 }
 
-void apply_camera(vtkRenderer* renderer, CameraPreset preset)
+void apply_camera(vtkRenderer* renderer, CameraPreset preset,
+                  const std::optional<std::array<double, 6>>& focus)
 {
   vtkCamera* camera = renderer->GetActiveCamera();
   camera->SetFocalPoint(0.0, 0.0, 0.0);
@@ -488,7 +489,13 @@ void apply_camera(vtkRenderer* renderer, CameraPreset preset)
     break;
   }
   camera->ParallelProjectionOn();
-  renderer->ResetCamera(); // keeps the direction, fits the bounds
+  if (focus) {
+    double b[6];
+    std::copy(focus->begin(), focus->end(), b);
+    renderer->ResetCamera(b); // fits the focus box (a followed part), keeps the direction
+  } else {
+    renderer->ResetCamera(); // keeps the direction, fits the bounds
+  }
   renderer->ResetCameraClippingRange();
 }
 
@@ -683,7 +690,7 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
     }
     scene->AddActor(bar_actor);
   }
-  apply_camera(scene, figure.camera);
+  apply_camera(scene, figure.camera, figure.focus_bounds);
 
   // Annotation layer: full window, owns the background, holds the title and the scalar bar.
   vtkNew<vtkRenderer> annotation;

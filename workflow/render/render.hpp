@@ -48,6 +48,9 @@ struct MeshFigure {
   CameraPreset camera = CameraPreset::Iso;
   int width = 1200, height = 900;
   std::optional<std::array<double, 2>> range; // colour range; default = data range (finite values)
+  // Box the camera fits (xmin xmax ymin ymax zmin zmax), e.g. the current bounds of a part the view
+  // follows; default = the whole mesh.
+  std::optional<std::array<double, 6>> focus_bounds;
 };
 
 // Surface of the hexahedra plus the bars as lines, coloured by the field (blue = low, red = high),
