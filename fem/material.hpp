@@ -32,6 +32,8 @@ class SolidMaterial {
   virtual double p_wave_modulus() const = 0;
   /// Initial elastic stiffness in the material frame (used for the hourglass stabilisation).
   virtual Voigt6x6 elastic_stiffness() const = 0;
+  /// The stiffest tangent the law can reach (e.g. a compacted tow): bounds the stable step.
+  virtual Voigt6x6 stable_step_stiffness() const { return elastic_stiffness(); }
   virtual int n_history() const { return 0; }
   virtual void update_stress(const MaterialBatch& batch) const = 0;
 };

@@ -1,0 +1,212 @@
+#include "drape/fabric_generator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "fem/errors.hpp"
+
+namespace ncfsim::drape {
+
+namespace {
+
+// Parameter interval [t0, t1] of the line p0 + t a inside the rectangle; false if it misses.
+bool clip_line(const std::array<double, 2>& p0, const std::array<double, 2>& a, const std::array<double, 2>& lo,
+               const std::array<double, 2>& hi, double& t0, double& t1) {
+  t0 = -std::numeric_limits<double>::infinity();
+  t1 = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 2; ++k) {
+    if (std::abs(a[k]) < 1e-14) {
+      if (p0[k] < lo[k] || p0[k] > hi[k]) return false;
+      continue;
+    }
+    double ta = (lo[k] - p0[k]) / a[k], tb = (hi[k] - p0[k]) / a[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t1 > t0;
+}
+
+}  // namespace
+
+FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl, const std::string& file,
+                             const std::string& prefix) {
+  validate(f, file, prefix.empty() ? "fabric" : prefix);
+  const double Lx = bl.size[0], Ly = bl.size[1];
+  const double p = f.tow_pitch(), w = f.tow_width, t = f.tow_thickness();
+  const double s = f.penetration_spacing(), g = f.gauge();
+  if (!(Lx > 2 * p && Ly > 2 * p))
+    throw InputError(file, "blanket.size", "the blanket must be larger than two tow pitches in x and y");
+  FabricModel fm;
+  fm.tow_thickness = t;
+  const std::array<double, 2> lo{bl.origin[0], bl.origin[1]}, hi{bl.origin[0] + Lx, bl.origin[1] + Ly};
+  // Penetration grid, centred in the blanket; its first point sets the gap lines of every ply.
+  const int nx = static_cast<int>(std::floor(Lx / s)), ny = static_cast<int>(std::floor(Ly / g));
+  const double x_first = lo[0] + 0.5 * (Lx - (nx - 1) * s), y_first = lo[1] + 0.5 * (Ly - (ny - 1) * g);
+  const double h_el = f.element_length > 0 ? f.element_length : p;
+  const int nw = f.elements_across_tow, nt = f.elements_through_thickness;
+
+  // Tows, ply by ply.
+  for (std::size_t q = 0; q < f.ply_angles_deg.size(); ++q) {
+    const int part = mesh.add_part(prefix + "ply" + std::to_string(q + 1));
+    fm.ply_parts.push_back(part);
+    const double al = f.ply_angles_deg[q] * M_PI / 180.0;
+    const std::array<double, 2> a{std::cos(al), std::sin(al)}, b{-std::sin(al), std::cos(al)};
+    const double phase = b[0] * x_first + b[1] * y_first;  // a gap line passes through the first point
+    // Range of b.x over the rectangle.
+    double bmin = 1e300, bmax = -1e300;
+    for (double x : {lo[0], hi[0]})
+      for (double y : {lo[1], hi[1]}) {
+        const double v = b[0] * x + b[1] * y;
+        bmin = std::min(bmin, v), bmax = std::max(bmax, v);
+      }
+    const long k0 = static_cast<long>(std::floor((bmin - phase) / p)) - 1;
+    const long k1 = static_cast<long>(std::ceil((bmax - phase) / p)) + 1;
+    const double z0 = bl.z0 + static_cast<double>(q) * t;
+    for (long k = k0; k <= k1; ++k) {
+      const double centre = phase + (static_cast<double>(k) + 0.5) * p;
+      // Each longitudinal node line m: b.x = centre - w/2 + m w/nw, clipped by the rectangle.
+      std::vector<double> t0(static_cast<std::size_t>(nw + 1)), t1(static_cast<std::size_t>(nw + 1));
+      bool ok = true;
+      double mean = 0;
+      for (int m = 0; m <= nw; ++m) {
+        const double beta = centre - 0.5 * w + w * m / nw;
+        const std::array<double, 2> p0{beta * b[0], beta * b[1]};
+        if (!clip_line(p0, a, lo, hi, t0[static_cast<std::size_t>(m)], t1[static_cast<std::size_t>(m)])) {
+          ok = false;
+          break;
+        }
+        mean += t1[static_cast<std::size_t>(m)] - t0[static_cast<std::size_t>(m)];
+      }
+      if (!ok) {
+        // The strip may still graze the rectangle at a corner: count it as dropped only if its centre line cuts.
+        double c0, c1;
+        const std::array<double, 2> pc{centre * b[0], centre * b[1]};
+        if (clip_line(pc, a, lo, hi, c0, c1)) ++fm.n_dropped_tows;
+        continue;
+      }
+      mean /= (nw + 1);
+      double shortest = 1e300;
+      for (int m = 0; m <= nw; ++m) shortest = std::min(shortest, t1[static_cast<std::size_t>(m)] - t0[static_cast<std::size_t>(m)]);
+      if (shortest < 2 * h_el) {
+        ++fm.n_dropped_tows;
+        continue;
+      }
+      const int nl = std::max(2, static_cast<int>(std::lround(mean / h_el)));
+      const std::int32_t base = static_cast<std::int32_t>(mesh.n_nodes());
+      // Nodes: index = base + (kz * (nw+1) + m) * (nl+1) + i
+      for (int kz = 0; kz <= nt; ++kz)
+        for (int m = 0; m <= nw; ++m) {
+          const double beta = centre - 0.5 * w + w * m / nw;
+          for (int i = 0; i <= nl; ++i) {
+            const double tt = t0[static_cast<std::size_t>(m)] +
+                              (t1[static_cast<std::size_t>(m)] - t0[static_cast<std::size_t>(m)]) * i / nl;
+            mesh.coords.push_back(beta * b[0] + tt * a[0]);
+            mesh.coords.push_back(beta * b[1] + tt * a[1]);
+            mesh.coords.push_back(z0 + t * kz / nt);
+          }
+        }
+      auto node = [&](int i, int m, int kz) { return base + (kz * (nw + 1) + m) * (nl + 1) + i; };
+      const auto tow = static_cast<std::int32_t>(fm.n_tows++);
+      fm.ply_of_tow.push_back(static_cast<int>(q));
+      for (int kz = 0; kz < nt; ++kz)
+        for (int m = 0; m < nw; ++m)
+          for (int i = 0; i < nl; ++i) {
+            // a x b = +z: (i, m) counter-clockwise seen from +z, VTK hexahedron order.
+            mesh.hexes.push_back({node(i, m, kz), node(i + 1, m, kz), node(i + 1, m + 1, kz), node(i, m + 1, kz),
+                                  node(i, m, kz + 1), node(i + 1, m, kz + 1), node(i + 1, m + 1, kz + 1),
+                                  node(i, m + 1, kz + 1)});
+            mesh.hex_part.push_back(part);
+            fm.tow_of_hex.push_back(tow);
+          }
+    }
+  }
+
+  if (f.stitch == StitchPattern::None) return fm;
+
+  // Stitch nodes at the penetration points, on the top and bottom faces.
+  const double z_bot = bl.z0, z_top = bl.z0 + t * static_cast<double>(f.ply_angles_deg.size());
+  std::vector<std::int32_t> top(static_cast<std::size_t>(nx * ny)), bot(static_cast<std::size_t>(nx * ny));
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double x = x_first + i * s, y = y_first + j * g;
+      for (auto* arr : {&top, &bot}) {
+        (*arr)[static_cast<std::size_t>(j * nx + i)] = static_cast<std::int32_t>(mesh.n_nodes());
+        fm.stitch_nodes.push_back(static_cast<std::int32_t>(mesh.n_nodes()));
+        mesh.coords.insert(mesh.coords.end(), {x, y, arr == &top ? z_top : z_bot});
+      }
+    }
+  fm.n_penetrations = static_cast<std::size_t>(nx * ny);
+  fm.stitch_I_part = mesh.add_part(prefix + "stitch_I");
+  fm.stitch_leg_part = mesh.add_part(prefix + "stitch_legs");
+  const bool tricot = f.stitch == StitchPattern::Tricot;
+  fm.stitch_Lambda_part = tricot ? mesh.add_part(prefix + "stitch_Lambda") : fm.stitch_I_part;
+  auto at = [&](std::vector<std::int32_t>& arr, int i, int j) { return arr[static_cast<std::size_t>(j * nx + i)]; };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {  // pillars along each wale, top face
+      mesh.bars.push_back({at(top, i, j), at(top, i + 1, j)});
+      mesh.bar_part.push_back(fm.stitch_I_part);
+    }
+  if (tricot) {
+    // Underlaps: the yarn of wale j laps between wales j and j+1 every course (zig-zag).
+    for (int j = 0; j + 1 < ny; ++j)
+      for (int i = 0; i + 1 < nx; ++i) {
+        mesh.bars.push_back({at(bot, i, j + (i % 2)), at(bot, i + 1, j + ((i + 1) % 2))});
+        mesh.bar_part.push_back(fm.stitch_Lambda_part);
+      }
+  } else {
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i + 1 < nx; ++i) {
+        mesh.bars.push_back({at(bot, i, j), at(bot, i + 1, j)});
+        mesh.bar_part.push_back(fm.stitch_I_part);
+      }
+  }
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      mesh.bars.push_back({at(top, i, j), at(bot, i, j)});
+      mesh.bar_part.push_back(fm.stitch_leg_part);
+    }
+
+  // Connections: each stitch node to the nearest node of every tow within reach on its face.
+  const double reach = 0.5 * f.tow_gap + std::max(w / nw, h_el) * 0.75;
+  const double cell = reach;
+  std::map<std::array<long, 2>, std::vector<std::int32_t>> grid;  // face nodes of tows, bucketed
+  std::vector<std::int32_t> tow_of_node(mesh.n_nodes(), -1);
+  for (std::size_t e = 0; e < fm.tow_of_hex.size(); ++e) {
+    const std::size_t he = mesh.hexes.size() - fm.tow_of_hex.size() + e;
+    for (auto nd : mesh.hexes[he]) tow_of_node[static_cast<std::size_t>(nd)] = fm.tow_of_hex[e];
+  }
+  for (std::size_t nd = 0; nd < tow_of_node.size(); ++nd) {
+    if (tow_of_node[nd] < 0) continue;
+    const double z = mesh.coords[3 * nd + 2];
+    if (std::abs(z - z_top) > 1e-9 * (1 + z_top) && std::abs(z - z_bot) > 1e-9 * (1 + z_top)) continue;
+    grid[{static_cast<long>(std::floor(mesh.coords[3 * nd] / cell)), static_cast<long>(std::floor(mesh.coords[3 * nd + 1] / cell))}]
+        .push_back(static_cast<std::int32_t>(nd));
+  }
+  for (auto sn : fm.stitch_nodes) {
+    const std::size_t i = static_cast<std::size_t>(sn);
+    const double x = mesh.coords[3 * i], y = mesh.coords[3 * i + 1], z = mesh.coords[3 * i + 2];
+    std::map<std::int32_t, std::pair<double, std::int32_t>> best;  // tow -> (distance, node)
+    const long cx = static_cast<long>(std::floor(x / cell)), cy = static_cast<long>(std::floor(y / cell));
+    for (long ix = cx - 1; ix <= cx + 1; ++ix)
+      for (long iy = cy - 1; iy <= cy + 1; ++iy) {
+        auto it = grid.find({ix, iy});
+        if (it == grid.end()) continue;
+        for (auto nd : it->second) {
+          const std::size_t k = static_cast<std::size_t>(nd);
+          if (std::abs(mesh.coords[3 * k + 2] - z) > 1e-9 * (1 + z_top)) continue;
+          const double d = std::hypot(mesh.coords[3 * k] - x, mesh.coords[3 * k + 1] - y);
+          if (d > reach) continue;
+          auto [it2, fresh] = best.try_emplace(tow_of_node[k], d, nd);
+          if (!fresh && d < it2->second.first) it2->second = {d, nd};
+        }
+      }
+    for (const auto& [tow, dn] : best)
+      if (dn.second >= 0) fm.connections.push_back({sn, dn.second});
+  }
+  return fm;
+}
+
+}  // namespace ncfsim::drape

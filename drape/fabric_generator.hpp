@@ -1,0 +1,46 @@
+#pragma once
+// Builds a meso model of a rectangular NCF blanket: each ply as distinct rows of hexahedra, one row
+// per tow (the paper's Fig. 3), tows placed so that the stitch penetration points fall into the gaps
+// between tows; the stitch as bar elements ('I' pillar segments on the top face, 'Lambda' zig-zag
+// underlaps on the bottom face for tricot, legs through the thickness at the penetration points);
+// each stitch node joined to the nearest node of each neighbouring tow by a connection.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drape/fabric.hpp"
+#include "fem/mesh.hpp"
+
+namespace ncfsim::drape {
+
+struct BlanketSpec {
+  std::array<double, 2> origin{0, 0};  // m, lower-left corner in x-y
+  std::array<double, 2> size{0, 0};    // m, along x (machine direction) and y
+  double z0 = 0;                       // m, bottom face
+};
+
+/// A stitch node joined to a tow node (elastic up to a sliding force, then sliding).
+struct StitchConnection {
+  std::int32_t stitch_node = -1, tow_node = -1;
+};
+
+struct FabricModel {
+  std::vector<int> ply_parts;          // part index per ply (hexahedra)
+  int stitch_I_part = -1, stitch_Lambda_part = -1, stitch_leg_part = -1;  // bar parts (-1: none)
+  std::vector<std::int32_t> tow_of_hex;   // per hexahedron added: global tow index
+  std::vector<int> ply_of_tow;            // per tow
+  std::vector<StitchConnection> connections;
+  std::vector<std::int32_t> stitch_nodes;
+  std::size_t n_tows = 0, n_dropped_tows = 0;
+  std::size_t n_penetrations = 0;
+  double tow_thickness = 0;
+};
+
+/// Appends the blanket to `mesh` (parts "<prefix>ply<k>", "<prefix>stitch_I", "<prefix>stitch_Lambda",
+/// "<prefix>stitch_legs"). Tows shorter than two elements at the corners are dropped (counted).
+/// Throws InputError for an inconsistent fabric or a blanket smaller than one stitch cell.
+FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& fabric, const BlanketSpec& blanket,
+                             const std::string& file = "", const std::string& prefix = "");
+
+}  // namespace ncfsim::drape

@@ -1,0 +1,155 @@
+// The blanket generator: element and stitch counts follow from the fabric geometry; tows of a ply
+// do not overlap (gap >= tow_gap everywhere); every stitch bar is joined at both ends (its nodes are
+// connected to tows); penetration points lie in the gaps of both plies; bad fabrics give InputError
+// naming the key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "drape/fabric_generator.hpp"
+#include "fem/errors.hpp"
+
+using namespace ncfsim;
+
+namespace {
+
+struct Built {
+  fem::Mesh mesh;
+  drape::FabricModel fm;
+};
+
+Built build(const drape::FabricSpec& f, double lx, double ly) {
+  Built b;
+  drape::BlanketSpec bl;
+  bl.size = {lx, ly};
+  b.fm = drape::generate_blanket(b.mesh, f, bl);
+  return b;
+}
+
+}  // namespace
+
+TEST(FabricGenerator, DefaultFabricGeometry) {
+  drape::FabricSpec f;
+  // Representative SAERTEX +-45 T700: 241 g/m^2 per ply, Vf 0.6, w/p = 3.22/3.32 -> t = 0.23 mm.
+  EXPECT_NEAR(f.tow_thickness(), 0.241 / (1800 * 0.6 * 3.22 / 3.32), 1e-12);
+  EXPECT_NEAR(f.gauge(), 3.32e-3 * std::sqrt(2.0), 1e-12);
+  EXPECT_NO_THROW(drape::validate(f, "", "fabric"));
+}
+
+TEST(FabricGenerator, CountsOfASquareBlanket) {
+  drape::FabricSpec f;
+  const double L = 0.05;
+  const auto b = build(f, L, L);
+  const auto& m = b.mesh;
+  ASSERT_EQ(b.fm.ply_parts.size(), 2u);
+  // Every hexahedron belongs to a tow; per tow nl x nw x nt elements with nl >= 2.
+  EXPECT_EQ(b.fm.tow_of_hex.size(), m.hexes.size());
+  std::vector<int> per_tow(b.fm.n_tows, 0);
+  for (auto t : b.fm.tow_of_hex) ++per_tow[static_cast<std::size_t>(t)];
+  for (int c : per_tow) {
+    EXPECT_EQ(c % (f.elements_across_tow * f.elements_through_thickness), 0);
+    EXPECT_GE(c, 2 * f.elements_across_tow * f.elements_through_thickness);
+  }
+  // A 45 deg strip of pitch p covers a square of side L with about 2 L / (p sqrt 2) tows per ply.
+  const double expected_tows_per_ply = 2 * L / (f.tow_pitch() * std::sqrt(2.0));
+  EXPECT_NEAR(static_cast<double>(b.fm.n_tows + b.fm.n_dropped_tows) / 2.0, expected_tows_per_ply, 3.0);
+  // Stitches: nx * ny penetrations; tricot: (nx-1) ny pillars, (nx-1)(ny-1) underlaps, nx ny legs.
+  const int nx = static_cast<int>(std::floor(L / f.penetration_spacing()));
+  const int ny = static_cast<int>(std::floor(L / f.gauge()));
+  EXPECT_EQ(b.fm.n_penetrations, static_cast<std::size_t>(nx * ny));
+  std::map<int, int> bars_per_part;
+  for (auto p : m.bar_part) ++bars_per_part[p];
+  EXPECT_EQ(bars_per_part[b.fm.stitch_I_part], (nx - 1) * ny);
+  EXPECT_EQ(bars_per_part[b.fm.stitch_Lambda_part], (nx - 1) * (ny - 1));
+  EXPECT_EQ(bars_per_part[b.fm.stitch_leg_part], nx * ny);
+  EXPECT_NO_THROW(m.validate());
+}
+
+TEST(FabricGenerator, TowsOfAPlyDoNotOverlap) {
+  drape::FabricSpec f;
+  const auto b = build(f, 0.04, 0.03);
+  const auto& m = b.mesh;
+  // Across-tow coordinate interval of every tow, per ply: neighbours are separated by the gap.
+  std::map<std::int32_t, std::pair<double, double>> span;
+  for (std::size_t e = 0; e < m.hexes.size(); ++e) {
+    const int ply = b.fm.ply_of_tow[static_cast<std::size_t>(b.fm.tow_of_hex[e])];
+    const double al = f.ply_angles_deg[static_cast<std::size_t>(ply)] * M_PI / 180;
+    for (auto nd : m.hexes[e]) {
+      const double v = -std::sin(al) * m.coords[3 * nd] + std::cos(al) * m.coords[3 * nd + 1];
+      auto [it, fresh] = span.try_emplace(b.fm.tow_of_hex[e], v, v);
+      it->second.first = std::min(it->second.first, v);
+      it->second.second = std::max(it->second.second, v);
+    }
+  }
+  for (const auto& [ta, sa] : span)
+    for (const auto& [tb, sb] : span) {
+      if (ta >= tb || b.fm.ply_of_tow[static_cast<std::size_t>(ta)] != b.fm.ply_of_tow[static_cast<std::size_t>(tb)]) continue;
+      const double gap = std::max(sb.first - sa.second, sa.first - sb.second);
+      EXPECT_GE(gap, f.tow_gap * (1 - 1e-9)) << "tows " << ta << " and " << tb;
+    }
+  // Each element has a positive volume proxy: tows lie in their ply's z slab.
+  const double t = f.tow_thickness();
+  for (std::size_t e = 0; e < m.hexes.size(); ++e) {
+    const int ply = b.fm.ply_of_tow[static_cast<std::size_t>(b.fm.tow_of_hex[e])];
+    for (auto nd : m.hexes[e]) {
+      EXPECT_GE(m.coords[3 * nd + 2], ply * t - 1e-12);
+      EXPECT_LE(m.coords[3 * nd + 2], (ply + 1) * t + 1e-12);
+    }
+  }
+}
+
+TEST(FabricGenerator, EveryStitchBarIsJoinedAtBothEnds) {
+  drape::FabricSpec f;
+  const auto b = build(f, 0.04, 0.04);
+  std::set<std::int32_t> connected;
+  for (const auto& c : b.fm.connections) connected.insert(c.stitch_node);
+  ASSERT_FALSE(b.mesh.bars.empty());
+  for (const auto& bar : b.mesh.bars)
+    for (auto nd : bar) EXPECT_TRUE(connected.count(nd)) << "stitch node " << nd << " is joined to no tow";
+  // A penetration point lies in a gap: on each face it meets two neighbouring tows, each at least
+  // half a gap away.
+  std::map<std::int32_t, int> per_node;
+  for (const auto& c : b.fm.connections) {
+    ++per_node[c.stitch_node];
+    const auto& X = b.mesh.coords;
+    const double d = std::hypot(X[3 * c.stitch_node] - X[3 * c.tow_node], X[3 * c.stitch_node + 1] - X[3 * c.tow_node + 1]);
+    EXPECT_GE(d, 0.5 * f.tow_gap * (1 - 1e-6));
+  }
+  // Away from the blanket edges (where a neighbouring tow may be cut off) both neighbours are joined.
+  for (const auto& [nd, n] : per_node) {
+    const double x = b.mesh.coords[3 * nd], y = b.mesh.coords[3 * nd + 1];
+    const double margin = 2 * f.tow_pitch();
+    if (x > margin && x < 0.04 - margin && y > margin && y < 0.04 - margin) {
+      EXPECT_GE(n, 2) << "stitch node " << nd;
+    }
+  }
+}
+
+TEST(FabricGenerator, BadFabricsNameTheKey) {
+  auto expect_key = [](drape::FabricSpec f, const std::string& key) {
+    try {
+      drape::validate(f, "case.toml", "fabric");
+      ADD_FAILURE() << "no error for " << key;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.key(), "fabric." + key) << e.what();
+    }
+  };
+  drape::FabricSpec f;
+  f.areal_weight = -0.2;
+  expect_key(f, "areal_weight");
+  f = {};
+  f.tow_width = 4.0e-3;  // pitch 4.1 mm no longer fits the 4.695 mm gauge
+  f.stitch_gauge = 3.32e-3 * std::sqrt(2.0);
+  f.stitch_length = 3.32e-3 * std::sqrt(2.0);
+  expect_key(f, "stitch_length");
+  f = {};
+  f.tow_gap = 0;
+  expect_key(f, "tow_gap");
+  f = {};
+  f.tow_fibre_volume_fraction = 0.95;
+  expect_key(f, "tow_fibre_volume_fraction");
+  f = {};
+  f.ply_angles_deg = {};
+  expect_key(f, "ply_angles_deg");
+}
