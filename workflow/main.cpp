@@ -10,6 +10,7 @@
 #include "fem/errors.hpp"
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
+#include "workflow/calibrate/calibrate_stitch.hpp"
 #include "workflow/case/engine_case.hpp"
 #include "workflow/figures/figures.hpp"
 #include "workflow/report/report.hpp"
@@ -66,6 +67,28 @@ int main(int argc, char** argv) {
   auto* report = app.add_subcommand("report", "Write report.html for a finished run");
   report->add_option("outdir", folder, "Output folder of a run")->required();
 
+  wf::StitchCalibrationOptions sc;
+  std::string shear = "positive";
+  auto* calibrate = app.add_subcommand("calibrate", "Calibrate model parameters from test data");
+  auto* cal_stitch = calibrate->add_subcommand(
+      "stitch", "Stitch force-strain law from bias-extension force data (Eq. 2-6): positive shear "
+                "calibrates the 'I' stitches, negative shear the 'Lambda' stitches");
+  calibrate->require_subcommand(1);
+  cal_stitch->add_option("data", sc.data, "CSV with a header row")->required()->check(CLI::ExistingFile);
+  cal_stitch->add_option("--extension-column", sc.extension_column, "Extension column (default extension_m)");
+  cal_stitch->add_option("--force-column", sc.force_column, "Force column (default force_N)");
+  cal_stitch->add_option("--extension-scale", sc.extension_scale, "Factor to m (1e-3 for mm)")->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--force-scale", sc.force_scale, "Factor to N")->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--shear", shear, "positive | negative")->check(CLI::IsMember({"positive", "negative"}));
+  cal_stitch->add_option("--coupon-length", sc.coupon.length, "Free length H, m (default 0.25)")->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--coupon-width", sc.coupon.width, "Width W, m (default 0.05)")->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--stitch-length", sc.coupon.stitch_length, "Stitch length c0, m (default 2.5e-3)")->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--gauge", sc.coupon.gauge, "Wale spacing h0, m (default 5.08e-3)")->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--max-shear-deg", sc.max_shear_deg, "Use data up to this central shear (default 30)")->check(CLI::Range(1.0, 60.0));
+  cal_stitch->add_option("--points", sc.points, "Points of the law (default 12)")->check(CLI::Range(2, 200));
+  cal_stitch->add_option("--name", sc.law_name, "Name of the [[bar_law]] (default stitch)");
+  cal_stitch->add_option("-o,--output", sc.out_dir, "Output folder (default stitch_calibration)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -95,6 +118,13 @@ int main(int argc, char** argv) {
       o.ranks = ranks;
       o.progress_interval_s = progress;
       return wf::run_engine_case(ec, o);
+    }
+    if (*cal_stitch) {
+      sc.sign = shear == "negative" ? ncfsim::drape::ShearSign::Negative : ncfsim::drape::ShearSign::Positive;
+      wf::calibrate_stitch(sc);
+      std::printf("%s: stitch_law.csv, stitch_law.toml, figures/stitch_law.png, figures/stitch_fit.png\n",
+                  sc.out_dir.c_str());
+      return wf::kSuccess;
     }
     if (*render) {
       require_output_folder(folder);

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -16,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drape/stitch_calibration.hpp"
 #include "fem/io/result_reader.hpp"
 
 namespace fs = std::filesystem;
@@ -200,4 +202,47 @@ TEST(CliRegression, InterruptedRunLeavesReadableResults) {
     EXPECT_NE(e.path().extension(), ".tmp") << "left a temporary file: " << e.path();
   fs::remove_all(out);
   fs::remove(log);
+}
+
+// `ncfsim calibrate stitch` round trip: synthetic bias-extension data (mm, irregular) made with a
+// known 'Lambda' stitch law through the Eq. 2-6 model give that law back within 5 %.
+TEST(Cli, CalibrateStitchRoundTrip) {
+  const fs::path dir = fresh_dir("calibrate");
+  fs::create_directories(dir);
+  ncfsim::drape::BiasExtensionCoupon c;
+  ncfsim::drape::StitchLaw truth;
+  for (int k = 0; k <= 30; ++k) {
+    const double e = 0.015 * k;
+    truth.strain.push_back(e);
+    truth.force.push_back(25 * e + 900 * e * e * e);
+  }
+  std::vector<double> D;
+  for (int k = 1; k <= 45; ++k) D.push_back(1e-3 * (0.9 * k + 0.3 * std::sin(k)));
+  const auto F = ncfsim::drape::coupon_force(c, ncfsim::drape::ShearSign::Negative, truth, D);
+  {
+    std::ofstream out(dir / "bias.csv");
+    out << "extension_mm,force_N\n";
+    for (std::size_t i = 0; i < D.size(); ++i) out << 1e3 * D[i] << "," << F[i] << "\n";
+  }
+  const Result r = run_cli({"calibrate", "stitch", (dir / "bias.csv").string(), "--extension-column", "extension_mm",
+                            "--extension-scale", "1e-3", "--shear", "negative", "-o", (dir / "out").string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream law(dir / "out/stitch_law.csv");
+  std::string line;
+  std::getline(law, line);
+  EXPECT_EQ(line, "strain,force_N");
+  int checked = 0;
+  while (std::getline(law, line)) {
+    const double e = std::stod(line.substr(0, line.find(','))), f = std::stod(line.substr(line.find(',') + 1));
+    if (e < 0.02) continue;
+    const double expected = 25 * e + 900 * e * e * e;
+    EXPECT_NEAR(f, expected, 0.05 * expected) << "strain " << e;
+    ++checked;
+  }
+  EXPECT_GE(checked, 8);
+  EXPECT_TRUE(fs::exists(dir / "out/stitch_law.toml"));
+  const Result bad = run_cli({"calibrate", "stitch", (dir / "bias.csv").string()});
+  EXPECT_EQ(bad.code, 2) << "a missing column is bad input: " << bad.output;
+  EXPECT_NE(bad.output.find("extension_m"), std::string::npos) << bad.output;
+  fs::remove_all(dir);
 }
