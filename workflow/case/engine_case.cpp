@@ -4,6 +4,9 @@
 #include <cmath>
 #include <map>
 
+#include "drape/fabric_generator.hpp"
+#include "drape/stitch_connection.hpp"
+#include "drape/tow_material.hpp"
 #include "fem/errors.hpp"
 #include "fem/mesh.hpp"
 #include "workflow/case/toml_reader.hpp"
@@ -98,9 +101,27 @@ std::vector<std::int32_t> select_nodes(const TableReader& owner, std::string_vie
 }
 
 std::unique_ptr<fem::SolidMaterial> read_material(const TableReader& t, const std::string& name) {
-  const std::string type = t.choice("type", {"elastic_isotropic", "elastic_orthotropic"}, "");
+  const std::string type = t.choice("type", {"elastic_isotropic", "elastic_orthotropic", "tow_biphase"}, "");
   const double rho = t.number("density", Range::positive());
   try {
+    if (type == "tow_biphase") {
+      drape::TowConstants c;
+      c.density = rho;
+      c.E11f = t.number("E11f", Range::non_negative());
+      c.E11m = t.number("E11m", Range::positive());
+      c.E22m = t.number("E22m", Range::positive());
+      c.E33m = t.number("E33m", Range::positive());
+      c.nu12m = t.number("nu12m", 0.0, {-1.0, 1.0, true, true});
+      c.nu13m = t.number("nu13m", 0.0, {-1.0, 1.0, true, true});
+      c.nu23m = t.number("nu23m", 0.0, {-1.0, 1.0, true, true});
+      c.G12m = t.number("G12m", Range::positive());
+      c.G13m = t.number("G13m", c.G12m, Range::positive());
+      c.G23m = t.number("G23m", c.G12m, Range::positive());
+      c.compaction_modulus = t.number("compaction_modulus", 0.0, Range::non_negative());
+      c.locking_width_ratio = t.number("locking_width_ratio", 0.7, {0.0, 1.0, true, true});
+      c.lock_stiffness_ratio = t.number("lock_stiffness_ratio", 50.0, Range::closed(1, 1e4));
+      return std::make_unique<drape::TowMaterial>(name, c);
+    }
     if (type == "elastic_isotropic") {
       const double E = t.number("youngs_modulus", Range::positive());
       const double nu = t.number("poisson_ratio", {-1.0, 0.5, true, true});
@@ -234,8 +255,8 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
   std::map<std::string, std::string> part_kind;  // part -> "solid" | "bar"
   const auto blocks = m.tables("block");
   const auto lines = m.tables("line");
-  if (blocks.empty() && lines.empty())
-    m.fail("block", "the mesh has no elements: give at least one [[mesh.block]] or [[mesh.line]]");
+  if (blocks.empty() && lines.empty() && !m.has("fabric"))
+    m.fail("block", "the mesh has no elements: give at least one [[mesh.block]], [[mesh.line]] or [[mesh.fabric]]");
   for (const auto& b : blocks) {
     const std::string part = b.string("part");
     const auto origin = b.vec3_or("origin", {0, 0, 0});
@@ -275,7 +296,70 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       mesh.bar_part.push_back(p);
     }
   }
-  fem::renumber_for_locality(mesh);
+  struct FabricEntry {
+    std::string name, tow_material, law_I, law_Lambda, law_legs;
+    std::vector<double> angles;
+    drape::FabricModel model;
+    drape::StitchConnectionSettings connection;
+    std::string path;
+  };
+  std::vector<FabricEntry> fabrics;
+  for (const auto& fb : m.tables("fabric")) {
+    FabricEntry fe;
+    fe.path = fb.path();
+    fe.name = fb.string("name");
+    drape::FabricSpec f;
+    if (fb.has("ply_angles_deg")) f.ply_angles_deg = fb.numbers("ply_angles_deg", Range::closed(-90, 90));
+    f.tow_width = fb.number("tow_width", f.tow_width, Range::positive());
+    f.tow_gap = fb.number("tow_gap", f.tow_gap, Range::positive());
+    f.areal_weight = fb.number("areal_weight", f.areal_weight, Range::positive());
+    f.fibre_density = fb.number("fibre_density", f.fibre_density, Range::positive());
+    f.tow_fibre_volume_fraction = fb.number("tow_fibre_volume_fraction", f.tow_fibre_volume_fraction, Range::open_closed(0, 0.9069));
+    const std::string stitch = fb.choice("stitch", {"tricot", "chain", "none"}, "tricot");
+    f.stitch = stitch == "tricot" ? drape::StitchPattern::Tricot : stitch == "chain" ? drape::StitchPattern::Chain : drape::StitchPattern::None;
+    f.stitch_gauge = fb.number("stitch_gauge", 0.0, Range::non_negative());
+    f.stitch_length = fb.number("stitch_length", 0.0, Range::non_negative());
+    f.elements_across_tow = static_cast<int>(fb.integer("elements_across_tow", 2, 1, 16));
+    f.elements_through_thickness = static_cast<int>(fb.integer("elements_through_thickness", 1, 1, 8));
+    f.element_length = fb.number("element_length", 0.0, Range::non_negative());
+    if (ec.resolution == "coarse") {
+      f.elements_across_tow = std::max(1, f.elements_across_tow / 2);
+      f.element_length = 2 * (f.element_length > 0 ? f.element_length : f.tow_pitch());
+    } else if (ec.resolution == "fine") {
+      f.elements_across_tow *= 2;
+      f.element_length = 0.5 * (f.element_length > 0 ? f.element_length : f.tow_pitch());
+    }
+    drape::BlanketSpec bl;
+    const auto origin = fb.vec3_or("origin", {0, 0, 0});
+    bl.origin = {origin[0], origin[1]};
+    bl.z0 = origin[2];
+    const auto size = fb.numbers("size", Range::positive(), 2);
+    if (size.size() != 2) fb.fail("size", "must hold 2 numbers [length along x, width along y]");
+    bl.size = {size[0], size[1]};
+    fe.tow_material = fb.string("tow_material");
+    if (f.stitch != drape::StitchPattern::None) {
+      fe.law_I = fb.string("stitch_law_I");
+      fe.law_Lambda = f.stitch == drape::StitchPattern::Tricot ? fb.string("stitch_law_Lambda") : fe.law_I;
+      fe.law_legs = fb.string("stitch_law_legs", fe.law_I);
+      fe.connection.sliding_force = fb.number("connection_sliding_force", 0.5, Range::positive());
+      fe.connection.stiffness = fb.number("connection_stiffness", 0.0, Range::non_negative());
+    }
+    fe.angles = f.ply_angles_deg;
+    drape::validate(f, fname, fb.path());
+    if (fe.name.empty() || fe.name.find_first_of(" ./\\") != std::string::npos)
+      fb.fail("name", "must be a non-empty name without spaces, dots or slashes (it prefixes the part names)");
+    fe.model = drape::generate_blanket(mesh, f, bl, fname, fe.name + "_");
+    for (int p : fe.model.ply_parts) part_kind[mesh.part_names[static_cast<std::size_t>(p)]] = "fabric";
+    for (int p : {fe.model.stitch_I_part, fe.model.stitch_Lambda_part, fe.model.stitch_leg_part})
+      if (p >= 0) part_kind[mesh.part_names[static_cast<std::size_t>(p)]] = "fabric";
+    fabrics.push_back(std::move(fe));
+  }
+  const auto new_of_old = fem::renumber_for_locality(mesh);
+  for (auto& fe : fabrics) {
+    for (auto& c : fe.model.connections)
+      c.stitch_node = new_of_old[static_cast<std::size_t>(c.stitch_node)], c.tow_node = new_of_old[static_cast<std::size_t>(c.tow_node)];
+    for (auto& nd : fe.model.stitch_nodes) nd = new_of_old[static_cast<std::size_t>(nd)];
+  }
   mesh.fill_default_user_ids();
 
   // Materials and bar laws.
@@ -300,6 +384,7 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
     const std::string name = t.string("name");
     const int p = mesh.find_part(name);
     if (p < 0) t.fail("name", "no mesh block or line uses part '" + name + "'");
+    if (part_kind[name] == "fabric") t.fail("name", "part '" + name + "' belongs to a [[mesh.fabric]]: its properties come from there");
     auto& pp = ec.model.parts[static_cast<std::size_t>(p)];
     defined[static_cast<std::size_t>(p)] = 1;
     if (part_kind[name] == "solid") {
@@ -316,6 +401,34 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       if (!bar_laws.count(law)) t.fail("bar_law", "no [[bar_law]] named '" + law + "'");
       pp.bar_law = bar_laws[law];
     }
+  }
+  for (const auto& fe : fabrics) {
+    auto need = [&](const std::map<std::string, int>& names, const std::string& n, const std::string& key) {
+      if (!names.count(n)) throw InputError(fname, fe.path + "." + key, "no such " + (key == "tow_material" ? std::string("[[material]]") : std::string("[[bar_law]]")) + " '" + n + "'");
+      return names.at(n);
+    };
+    const int tow = need(materials, fe.tow_material, "tow_material");
+    for (std::size_t q = 0; q < fe.model.ply_parts.size(); ++q) {
+      auto& pp = ec.model.parts[static_cast<std::size_t>(fe.model.ply_parts[q])];
+      pp.kind = fem::PartProperties::Kind::Solid;
+      pp.material = tow;
+      const double al = fe.angles[q] * M_PI / 180.0;
+      pp.material_axes = {std::cos(al), -std::sin(al), 0, std::sin(al), std::cos(al), 0, 0, 0, 1};
+      defined[static_cast<std::size_t>(fe.model.ply_parts[q])] = 1;
+    }
+    const std::pair<int, std::string> bar_parts[] = {{fe.model.stitch_I_part, fe.law_I}, {fe.model.stitch_Lambda_part, fe.law_Lambda},
+                                                     {fe.model.stitch_leg_part, fe.law_legs}};
+    for (const auto& [p, law] : bar_parts) {
+      if (p < 0) continue;
+      auto& pp = ec.model.parts[static_cast<std::size_t>(p)];
+      pp.kind = fem::PartProperties::Kind::Bar;
+      pp.bar_law = need(bar_laws, law, law == fe.law_I ? "stitch_law_I" : law == fe.law_Lambda ? "stitch_law_Lambda" : "stitch_law_legs");
+      defined[static_cast<std::size_t>(p)] = 1;
+    }
+    if (!fe.model.connections.empty())
+      ec.model.contacts.push_back(std::make_unique<drape::StitchToTowConnection>(fe.name + "_stitch_tow", fe.model.connections, fe.connection));
+    ec.fabric_summaries.push_back({fe.name, fe.model.n_tows, fe.model.n_dropped_tows, fe.model.n_penetrations,
+                                   fe.model.connections.size(), fe.model.tow_thickness});
   }
   for (std::size_t p = 0; p < defined.size(); ++p)
     if (!defined[p]) root.fail("part", "part '" + mesh.part_names[p] + "' has no [[part]] entry (material)");

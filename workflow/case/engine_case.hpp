@@ -66,6 +66,13 @@ struct PictureSpec {
   double deformation_scale = 1.0;
 };
 
+/// What a [[mesh.fabric]] generated (echoed in the log and summary.json).
+struct FabricSummary {
+  std::string name;
+  std::size_t tows = 0, dropped_tows = 0, penetrations = 0, connections = 0;
+  double tow_thickness = 0;
+};
+
 struct EngineCase {
   std::filesystem::path file;
   std::string name;
@@ -78,6 +85,7 @@ struct EngineCase {
   OutputSettings output;
   std::vector<PlotSpec> plots;
   std::vector<PictureSpec> pictures;
+  std::vector<FabricSummary> fabric_summaries;
 };
 
 /// Reads and checks a case (throws InputError naming file and key). `overrides` are --set items.

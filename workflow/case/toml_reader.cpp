@@ -64,13 +64,31 @@ toml::table* ensure_table(toml::table& root, const std::vector<std::string>& par
                           const std::string& file, const std::string& key) {
   toml::table* t = &root;
   for (std::size_t i = 0; i < upto; ++i) {
+    // "block[2]": an entry of an array of tables.
+    const auto open = parts[i].find('[');
+    if (open != std::string::npos && parts[i].back() == ']') {
+      const std::string name = parts[i].substr(0, open);
+      std::size_t idx = 0;
+      try {
+        idx = std::stoul(parts[i].substr(open + 1, parts[i].size() - open - 2));
+      } catch (const std::exception&) {
+        throw InputError(file, key, "--set: bad index in '" + parts[i] + "'");
+      }
+      toml::node* an = t->get(name);
+      toml::array* arr = an ? an->as_array() : nullptr;
+      if (!arr || !arr->is_array_of_tables() || idx >= arr->size())
+        throw InputError(file, key, "--set: there is no [[" + name + "]] entry " + std::to_string(idx));
+      t = arr->get(idx)->as_table();
+      continue;
+    }
     toml::node* n = t->get(parts[i]);
     if (!n) {
       t->insert(parts[i], toml::table{});
       n = t->get(parts[i]);
     }
     if (!n->is_table())
-      throw InputError(file, key, "--set cannot descend into '" + parts[i] + "', which is " + type_name(*n));
+      throw InputError(file, key, "--set cannot descend into '" + parts[i] + "', which is " + type_name(*n) +
+                                      (n->is_array() ? " (use " + parts[i] + "[0]. for an entry of [[" + parts[i] + "]])" : ""));
     t = n->as_table();
   }
   return t;

@@ -164,6 +164,15 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
 
   log->info("mesh: {} nodes, {} hexahedra, {} bars, {} parts, {} tools", model.mesh.n_nodes(),
             solver.n_hexes(), solver.n_bars(), model.mesh.part_names.size(), model.tools.size());
+  json fabrics = json::object();
+  for (const auto& f : ec.fabric_summaries) {
+    log->info("fabric {}: {} tows ({} dropped at the corners), tow thickness {:.4g} mm, {} stitch penetrations, "
+              "{} stitch-to-tow connections", f.name, f.tows, f.dropped_tows, 1e3 * f.tow_thickness, f.penetrations,
+              f.connections);
+    fabrics[f.name] = {{"tows", f.tows}, {"dropped_tows", f.dropped_tows}, {"tow_thickness_m", f.tow_thickness},
+                       {"stitch_penetrations", f.penetrations}, {"stitch_connections", f.connections}};
+  }
+  if (!ec.fabric_summaries.empty()) summary["fabrics"] = fabrics;
   const auto& st = solver.controlling_element();
   log->info("stable step {:.4g} s (safety factor {}), controlled by {} {}", solver.time_step(),
             model.time.safety_factor, st.is_bar ? "bar" : "hexahedron", st.element);
