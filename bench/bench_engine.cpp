@@ -1,5 +1,326 @@
-// Placeholder, replaced by the engine benchmark.
+// Engine throughput (issue #2, item 8): ns per element-cycle on one core.
+//
+//   HexFullCycle/<material>/<numbering>  full ExplicitSolver::step() cycles on a 60x50x40 block of
+//                                        120,000 hexahedra (base fixed, non-uniform velocity field):
+//                                        internal force (geometry, strain, material, Cauchy stress,
+//                                        hourglass, scatter), loads, nodal update, positions
+//   HexInternalForceOnly/<material>      hex8_internal_forces alone on the same block;
+//                                        ".../l2_resident": a 2,048-element block whose state stays
+//                                        in L2 (the compute-bound figure, for reference)
+//   BarFullCycle                         full cycles of a 40x40x26-node lattice of 121,120
+//                                        tension-only bars, tabulated law, pre-stretched so that
+//                                        every segment of the table and slack bars occur
+//   BarInternalForceOnly                 bar_internal_forces alone
+//
+// Numbering: "local" = renumber_for_locality (what the engine does on input); "random_nodes" =
+// node ids shuffled, elements in generation order; "random_all" = nodes and elements shuffled.
+// Counters: ns_per_hex_cycle / ns_per_bar_cycle = thread CPU time / (cycles x elements), so time
+// descheduled on a shared machine is not counted; wall_* the same from wall time. Each benchmark
+// runs a fixed number of cycles, 3 repetitions; mean, median, min are reported. < 1 min in all.
 #include <benchmark/benchmark.h>
-static void BM_Nothing(benchmark::State& s) { for (auto _ : s) benchmark::DoNotOptimize(0); }
-BENCHMARK(BM_Nothing);
-BENCHMARK_MAIN();
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <numeric>
+#include <random>
+#include <string>
+#include <time.h>
+
+#include "fem/model.hpp"
+#include "fem/petsc_vector.hpp"
+#include "fem/solver.hpp"
+
+using namespace ncfsim;
+
+namespace {
+
+enum class Mat { Isotropic, Orthotropic };
+enum class Numbering { Local, RandomNodes, RandomAll };
+
+constexpr std::array<int, 3> kHexDiv{60, 50, 40};  // 120,000 hexahedra, h = 10 mm
+constexpr std::array<int, 3> kSmallHexDiv{16, 16, 8};  // 2,048 hexahedra: state stays in L2
+constexpr std::array<int, 3> kLatticeNodes{40, 40, 26};  // 121,120 bars, 10 mm apart
+
+struct Fixture {
+  fem::Model model;
+  std::unique_ptr<fem::ExplicitSolver> solver;
+  std::string key;
+};
+
+// One model alive at a time: repetitions of a benchmark reuse it, the next benchmark replaces it
+// (released before PETSc finalises).
+std::unique_ptr<Fixture> g_fixture;
+
+// Shuffles node ids (and optionally element order) of a mesh built in structured order.
+void shuffle_numbering(fem::Mesh& mesh, bool elements, std::mt19937_64& rng) {
+  const std::size_t n = mesh.n_nodes();
+  std::vector<std::int32_t> new_of_old(n);
+  std::iota(new_of_old.begin(), new_of_old.end(), 0);
+  std::shuffle(new_of_old.begin(), new_of_old.end(), rng);
+  std::vector<double> coords(mesh.coords.size());
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) coords[3 * static_cast<std::size_t>(new_of_old[i]) + k] = mesh.coords[3 * i + k];
+  mesh.coords.swap(coords);
+  for (auto& h : mesh.hexes)
+    for (auto& v : h) v = new_of_old[static_cast<std::size_t>(v)];
+  for (auto& b : mesh.bars)
+    for (auto& v : b) v = new_of_old[static_cast<std::size_t>(v)];
+  if (elements) {
+    std::shuffle(mesh.hexes.begin(), mesh.hexes.end(), rng);  // one part: part tags unchanged
+    std::shuffle(mesh.bars.begin(), mesh.bars.end(), rng);
+  }
+  mesh.node_user_id.clear();
+  mesh.hex_user_id.clear();
+  mesh.bar_user_id.clear();
+  mesh.fill_default_user_ids();
+}
+
+void apply_numbering(fem::Mesh& mesh, Numbering num) {
+  std::mt19937_64 rng(12345);
+  if (num == Numbering::Local)
+    fem::renumber_for_locality(mesh);
+  else
+    shuffle_numbering(mesh, num == Numbering::RandomAll, rng);
+}
+
+// A smooth, non-uniform velocity field (bending, shear and stretching) with 2 % node noise, so
+// that strains, stresses and hourglass forces are all non-trivial. Fixed DOFs stay at zero.
+void set_velocity_field(fem::ExplicitSolver& s, double v0, bool noise) {
+  const auto& m = s.model().mesh;
+  std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (std::size_t i = 0; i < m.n_nodes(); ++i)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.coords[3 * i + k]), hi[k] = std::max(hi[k], m.coords[3 * i + k]);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto V = s.v.view();
+  auto X = s.x.view();
+  constexpr double pi = std::numbers::pi;
+  for (std::size_t i = 0; i < m.n_nodes(); ++i) {
+    const double x = (X[3 * i] - lo[0]) / (hi[0] - lo[0]), y = (X[3 * i + 1] - lo[1]) / (hi[1] - lo[1]),
+                 z = (X[3 * i + 2] - lo[2]) / (hi[2] - lo[2]);
+    const double r = noise ? 0.02 : 0.0;
+    V[3 * i] = v0 * (std::sin(pi * z) * std::cos(pi * y) + 0.3 * x + r * u(rng));
+    V[3 * i + 1] = v0 * (0.5 * std::sin(pi * x) * z + 0.2 * y + r * u(rng));
+    V[3 * i + 2] = v0 * (z * std::sin(0.5 * pi * x) - 0.1 * z + r * u(rng));
+  }
+  // Fixed DOFs of the model are zeroed again by the first step.
+}
+
+Fixture& hex_fixture(Mat mat, Numbering num, bool small = false) {
+  const std::string key = "hex" + std::to_string(int(mat)) + std::to_string(int(num)) + (small ? "s" : "");
+  if (g_fixture && g_fixture->key == key) return *g_fixture;
+  g_fixture.reset();
+  auto fx = std::make_unique<Fixture>();
+  fx->key = key;
+  fem::Model& model = fx->model;
+  const int p = model.mesh.add_part("block");
+  const auto div = small ? kSmallHexDiv : kHexDiv;
+  fem::add_hex_block(model.mesh, p, {0, 0, 0}, {0.01 * div[0], 0.01 * div[1], 0.01 * div[2]}, div);
+  model.parts.resize(1);
+  model.parts[0].kind = fem::PartProperties::Kind::Solid;
+  model.parts[0].material = 0;
+  if (mat == Mat::Isotropic) {
+    model.materials.push_back(std::make_unique<fem::ElasticIsotropic>("steel", 7850.0, 210e9, 0.3));
+  } else {
+    // Carbon/epoxy-like, fibre axes turned 30 degrees about z.
+    const fem::OrthotropicConstants c{135e9, 10e9, 10e9, 0.3, 0.3, 0.45, 5e9, 5e9, 3.5e9};
+    model.materials.push_back(std::make_unique<fem::ElasticOrthotropic>("cfrp", 1550.0, c));
+    const double a = std::numbers::pi / 6, ca = std::cos(a), sa = std::sin(a);
+    model.parts[0].material_axes = {ca, -sa, 0, sa, ca, 0, 0, 0, 1};
+  }
+  apply_numbering(model.mesh, num);
+  std::vector<std::int32_t> base;
+  for (std::size_t i = 0; i < model.mesh.n_nodes(); ++i)
+    if (model.mesh.coords[3 * i + 2] < 1e-9) base.push_back(static_cast<std::int32_t>(i));
+  model.fixed.push_back({"base", base, {true, true, true}});
+  model.time.end_time = 1.0;
+  fx->solver = std::make_unique<fem::ExplicitSolver>(model);
+  set_velocity_field(*fx->solver, 1.0, true);
+  for (int k = 0; k < 3; ++k) fx->solver->step();  // warm caches, non-zero stress state
+  g_fixture = std::move(fx);
+  return *g_fixture;
+}
+
+// `use` keeps the two bar benchmarks on separate, fresh fixtures: the kernel-only figure must not
+// depend on the state the full cycles left behind.
+Fixture& bar_fixture(const std::string& use) {
+  const std::string key = "bar/" + use;
+  if (g_fixture && g_fixture->key == key) return *g_fixture;
+  g_fixture.reset();
+  auto fx = std::make_unique<Fixture>();
+  fx->key = key;
+  fem::Model& model = fx->model;
+  auto& mesh = model.mesh;
+  const int p = mesh.add_part("stitches");
+  const auto [a, b, c] = kLatticeNodes;
+  const double h = 0.01;
+  auto id = [&](int i, int j, int k) { return static_cast<std::int32_t>(i + a * (j + b * k)); };
+  for (int k = 0; k < c; ++k)
+    for (int j = 0; j < b; ++j)
+      for (int i = 0; i < a; ++i) {
+        mesh.coords.push_back(h * i);
+        mesh.coords.push_back(h * j);
+        mesh.coords.push_back(h * k);
+      }
+  for (int k = 0; k < c; ++k)
+    for (int j = 0; j < b; ++j)
+      for (int i = 0; i < a; ++i) {
+        if (i + 1 < a) mesh.bars.push_back({id(i, j, k), id(i + 1, j, k)});
+        if (j + 1 < b) mesh.bars.push_back({id(i, j, k), id(i, j + 1, k)});
+        if (k + 1 < c) mesh.bars.push_back({id(i, j, k), id(i, j, k + 1)});
+      }
+  mesh.bar_part.assign(mesh.bars.size(), p);
+  // Polyester-yarn-like tabulated law, tension only: toe, linear, stiffening.
+  model.bar_laws.emplace_back("yarn", std::vector<double>{0.0, 0.005, 0.02, 0.05, 0.1},
+                              std::vector<double>{0.0, 0.5, 4.0, 15.0, 40.0}, true, 1e-5);
+  model.parts.resize(1);
+  model.parts[0].kind = fem::PartProperties::Kind::Bar;
+  model.parts[0].bar_law = 0;
+  fem::renumber_for_locality(mesh);
+  // The boundary nodes are held, so that the stretch below stays in the lattice.
+  std::vector<std::int32_t> boundary;
+  for (std::size_t i = 0; i < mesh.n_nodes(); ++i) {
+    bool on = false;
+    for (int k = 0; k < 3; ++k) {
+      const double xk = mesh.coords[3 * i + k], hi = h * (kLatticeNodes[static_cast<std::size_t>(k)] - 1);
+      on = on || xk < 1e-9 || xk > hi - 1e-9;
+    }
+    if (on) boundary.push_back(static_cast<std::int32_t>(i));
+  }
+  model.fixed.push_back({"boundary", boundary, {true, true, true}});
+  model.time.end_time = 1.0;
+  fx->solver = std::make_unique<fem::ExplicitSolver>(model);
+  // Loaded state: 3 % mean stretch with node noise puts the bars in every segment of the table,
+  // a few percent slack; a small random velocity keeps it moving.
+  {
+    auto V = fx->solver->v.view();
+    auto X = fx->solver->x.view();
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (std::size_t i = 0; i < 3 * mesh.n_nodes(); ++i) {
+      X[i] = 1.03 * X[i] + 0.0005 * u(rng);
+      V[i] = 0.1 * u(rng);
+    }
+  }
+  for (int k = 0; k < 3; ++k) fx->solver->step();
+  g_fixture = std::move(fx);
+  return *g_fixture;
+}
+
+// Thread CPU time: on a shared machine, time spent descheduled is not charged to the engine.
+struct Timer {
+  static double cpu() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  }
+  static double wall() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+  double c0 = cpu(), w0 = wall();
+};
+
+// ns_per_*_cycle from thread CPU time, wall_ns_per_*_cycle from wall time.
+void report(benchmark::State& state, const std::string& name, const Timer& t, std::size_t element_cycles_per_iteration) {
+  const double cpu = Timer::cpu() - t.c0, wall = Timer::wall() - t.w0;
+  const double ec = static_cast<double>(state.iterations()) * static_cast<double>(element_cycles_per_iteration);
+  state.counters[name] = benchmark::Counter(1e9 * cpu / ec);
+  state.counters["wall_" + name] = benchmark::Counter(1e9 * wall / ec);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(element_cycles_per_iteration));
+}
+
+void BM_HexFullCycle(benchmark::State& state, Mat mat, Numbering num) {
+  auto& fx = hex_fixture(mat, num);
+  auto& s = *fx.solver;
+  const Timer t;
+  for (auto _ : state) s.step();
+  benchmark::DoNotOptimize(s.energy().internal);
+  report(state, "ns_per_hex_cycle", t, s.n_hexes());
+}
+
+void BM_HexInternalForceOnly(benchmark::State& state, Mat mat, bool small) {
+  auto& fx = hex_fixture(mat, Numbering::Local, small);
+  auto& s = *fx.solver;
+  auto& blk = s.hex_blocks().at(0);
+  auto X = s.x.view();
+  auto V = s.v.view();
+  auto F = s.f_int.view();
+  const double dt = s.time_step();
+  const int reps = small ? 50 : 1;  // the small block: 50 calls per iteration
+  fem::ElementEnergyIncrement inc;
+  const Timer t;
+  for (auto _ : state) {
+    for (int r = 0; r < reps; ++r) {
+      fem::StableStep st;
+      std::fill(F.data(), F.data() + F.size(), 0.0);
+      fem::hex8_internal_forces(blk, X.data(), V.data(), dt, F.data(), inc, st);
+      benchmark::DoNotOptimize(st.dt);
+    }
+  }
+  benchmark::DoNotOptimize(inc.internal);
+  report(state, "ns_per_hex_cycle", t, blk.n * static_cast<std::size_t>(reps));
+}
+
+void BM_BarFullCycle(benchmark::State& state) {
+  auto& s = *bar_fixture("full").solver;
+  const Timer t;
+  for (auto _ : state) s.step();
+  benchmark::DoNotOptimize(s.energy().internal);
+  report(state, "ns_per_bar_cycle", t, s.n_bars());
+}
+
+void BM_BarInternalForceOnly(benchmark::State& state) {
+  auto& s = *bar_fixture("kernel").solver;
+  auto& blk = s.bar_blocks().at(0);
+  auto X = s.x.view();
+  auto F = s.f_int.view();
+  fem::ElementEnergyIncrement inc;
+  const Timer t;
+  for (auto _ : state) {
+    fem::StableStep st;
+    std::fill(F.data(), F.data() + F.size(), 0.0);
+    fem::bar_internal_forces(blk, X.data(), F.data(), inc, st);
+    benchmark::DoNotOptimize(st.dt);
+  }
+  benchmark::DoNotOptimize(inc.internal);
+  report(state, "ns_per_bar_cycle", t, blk.n);
+}
+
+double min_of(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+
+void common(benchmark::internal::Benchmark* b, int iterations) {
+  b->Iterations(iterations)->Repetitions(3)->ReportAggregatesOnly(true)->Unit(benchmark::kMillisecond);
+  b->ComputeStatistics("min", min_of);
+}
+
+void register_all() {
+  using benchmark::RegisterBenchmark;
+  common(RegisterBenchmark("HexFullCycle/isotropic/local", BM_HexFullCycle, Mat::Isotropic, Numbering::Local), 40);
+  common(RegisterBenchmark("HexFullCycle/orthotropic/local", BM_HexFullCycle, Mat::Orthotropic, Numbering::Local), 40);
+  common(RegisterBenchmark("HexFullCycle/isotropic/random_nodes", BM_HexFullCycle, Mat::Isotropic,
+                           Numbering::RandomNodes), 40);
+  common(RegisterBenchmark("HexFullCycle/isotropic/random_all", BM_HexFullCycle, Mat::Isotropic,
+                           Numbering::RandomAll), 40);
+  common(RegisterBenchmark("HexInternalForceOnly/isotropic", BM_HexInternalForceOnly, Mat::Isotropic, false), 40);
+  common(RegisterBenchmark("HexInternalForceOnly/orthotropic", BM_HexInternalForceOnly, Mat::Orthotropic, false), 40);
+  common(RegisterBenchmark("HexInternalForceOnly/isotropic/l2_resident", BM_HexInternalForceOnly, Mat::Isotropic,
+                           true), 40);
+  common(RegisterBenchmark("BarFullCycle", BM_BarFullCycle), 200);
+  common(RegisterBenchmark("BarInternalForceOnly", BM_BarInternalForceOnly), 200);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  register_all();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  {
+    fem::PetscSession petsc(&argc, &argv);
+    benchmark::RunSpecifiedBenchmarks();
+    g_fixture.reset();  // PETSc vectors die before PetscFinalize
+  }
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,9 +1,14 @@
+// GCC 12 reports false maybe-uninitialized warnings inside its own AVX-512 intrinsics (the
+// undefined pass-through operand of the masked sqrt) when it inlines std::experimental::simd.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include "fem/bar_block.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "fem/errors.hpp"
+#include "fem/simd_batch.hpp"
 
 namespace ncfsim::fem {
 
@@ -76,29 +81,76 @@ void bar_lumped_mass(const BarBlock& b, double* mass) {
 
 void bar_internal_forces(BarBlock& b, const double* x, double* f, ElementEnergyIncrement& energy,
                          StableStep& step) {
+  // Batched: W bars per SIMD register for the strain, law and force; the node gathers are per
+  // lane and the force scatter runs per chunk as a plain loop (nodes shared by consecutive bars
+  // then chain through the store buffer without stalling the vector work).
+  using batch::load;
+  using batch::store;
+  using batch::VD;
+  using batch::W;
+  namespace stdx = batch::stdx;
+  constexpr int BC = 256;  // bars per chunk
+  static_assert(BC % W == 0, "chunk must hold whole SIMD batches");
   const std::size_t n = b.n;
   const BarForceLaw& law = *b.law;
-  const std::int32_t* __restrict c0 = b.conn.data();
-  const std::int32_t* __restrict c1 = b.conn.data() + n;
-  double w = 0;
-  for (std::size_t e = 0; e < n; ++e) {
-    const auto i = static_cast<std::size_t>(c0[e]), j = static_cast<std::size_t>(c1[e]);
-    const double dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
-    const double L = std::sqrt(dx * dx + dy * dy + dz * dz);
-    const double L0 = b.length0[e];
-    const double eps = L / L0 - 1.0;
-    const double F = law.force(eps);
-    w += 0.5 * (F + b.force[e]) * (eps - b.strain[e]) * L0;
-    b.strain[e] = eps;
-    b.force[e] = F;
-    const double s = F / L;
-    f[3 * i] += s * dx, f[3 * i + 1] += s * dy, f[3 * i + 2] += s * dz;
-    f[3 * j] -= s * dx, f[3 * j + 1] -= s * dy, f[3 * j + 2] -= s * dz;
-    if (b.dt_crit[e] < step.dt) step = {b.dt_crit[e], b.user_id[e], true};
+  const double* ts = law.strains().data();
+  const double* tf = law.forces().data();
+  const double* tk = law.slopes().data();
+  const int n_seg = static_cast<int>(law.slopes().size());
+  const bool tension_only = law.tension_only();
+  const std::int32_t* c0 = b.conn.data();
+  const std::int32_t* c1 = b.conn.data() + n;
+  const double* L0p = b.length0.data();
+  const double* dtc = b.dt_crit.data();
+  double* eps_p = b.strain.data();
+  double* F_p = b.force.data();
+  alignas(64) double sx[BC], sy[BC], sz[BC];  // axial force vector of each bar of the chunk
+  VD w = 0.0;
+  for (std::size_t e0 = 0; e0 < n; e0 += BC) {
+    const int m = static_cast<int>(std::min<std::size_t>(BC, n - e0));
+    for (int k = 0; k < m; k += W) {
+      const int cnt = std::min(W, m - k);
+      const std::size_t e = e0 + static_cast<std::size_t>(k);
+      std::size_t ii[W], jj[W];
+      for (int l = 0; l < W; ++l) {
+        const std::size_t q = e + static_cast<std::size_t>(l < cnt ? l : cnt - 1);
+        ii[l] = 3 * static_cast<std::size_t>(c0[q]), jj[l] = 3 * static_cast<std::size_t>(c1[q]);
+      }
+      const VD dx([&](auto l) { return x[jj[l]] - x[ii[l]]; });
+      const VD dy([&](auto l) { return x[jj[l] + 1] - x[ii[l] + 1]; });
+      const VD dz([&](auto l) { return x[jj[l] + 2] - x[ii[l] + 2]; });
+      const VD L = stdx::sqrt(dx * dx + dy * dy + dz * dz);
+      const VD L0 = load(L0p + e, cnt);
+      const VD eps = L / L0 - 1.0;
+      // Table segment: the last one starting below the strain, as BarForceLaw::force.
+      VD Fs = tf[0], ks = tk[0], es = ts[0];
+      for (int i = 1; i < n_seg; ++i) {
+        const auto above = eps > ts[i];
+        stdx::where(above, Fs) = tf[i];
+        stdx::where(above, ks) = tk[i];
+        stdx::where(above, es) = ts[i];
+      }
+      VD F = Fs + ks * (eps - es);
+      if (tension_only) stdx::where(eps <= 0.0, F) = 0.0;
+      w += batch::live(0.5 * (F + load(F_p + e, cnt)) * (eps - load(eps_p + e, cnt)) * L0, cnt);
+      store(eps_p + e, eps, cnt);
+      store(F_p + e, F, cnt);
+      const VD s = F / L;
+      batch::store_a(sx + k, s * dx), batch::store_a(sy + k, s * dy), batch::store_a(sz + k, s * dz);
+      if (stdx::any_of(load(dtc + e, cnt) < step.dt))  // rare: scan in element order
+        for (int l = 0; l < cnt; ++l)
+          if (dtc[e + l] < step.dt) step = {dtc[e + l], b.user_id[e + l], true};
+    }
+    for (int k = 0; k < m; ++k) {
+      const std::size_t i = 3 * static_cast<std::size_t>(c0[e0 + k]), j = 3 * static_cast<std::size_t>(c1[e0 + k]);
+      f[i] += sx[k], f[i + 1] += sy[k], f[i + 2] += sz[k];
+      f[j] -= sx[k], f[j + 1] -= sy[k], f[j + 2] -= sz[k];
+    }
   }
-  if (!std::isfinite(w))
+  const double wsum = stdx::reduce(w);
+  if (!std::isfinite(wsum))
     throw NumericalError("bar part " + std::to_string(b.part) + " produced a non-finite force");
-  energy.internal += w;
+  energy.internal += wsum;
 }
 
 }  // namespace ncfsim::fem

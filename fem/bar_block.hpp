@@ -25,6 +25,11 @@ class BarForceLaw {
     while (i + 2 < n && strain > strain_[i + 1]) ++i;  // tables are short: a scan beats bisection
     return force_[i] + slope_[i] * (strain - strain_[i]);
   }
+  // The table as evaluated (origin prepended where needed), for the batched kernel: segment i
+  // starts at strains()[i] with forces()[i] and slopes()[i].
+  const std::vector<double>& strains() const { return strain_; }
+  const std::vector<double>& forces() const { return force_; }
+  const std::vector<double>& slopes() const { return slope_; }
   double max_slope() const { return max_slope_; }
   double linear_density() const { return rho_l_; }
   bool tension_only() const { return tension_only_; }

@@ -31,6 +31,7 @@ struct Hex8Block {
   std::vector<double> hg_force;        // [12][n] hourglass generalised forces, element frame, [3*mode+axis]
   std::vector<double> mat_axes;        // [9][n] reference material axes, global (row-major, axes = columns)
   std::vector<double> jac_inv0;        // [9][n] inverse of the reference centre Jacobian
+  std::vector<double> jac_inv0_axes;   // [9][n] jac_inv0 * mat_axes: F M = J jac_inv0_axes (kernel)
   std::vector<double> hg_moduli;       // [6][n] E1 E2 E3 G12 G23 G13 along the element axes
   std::vector<double> volume;          // [n] current volume
   std::vector<double> volume0;         // [n] reference volume

@@ -41,8 +41,20 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
     std::copy(mesh.coords.begin(), mesh.coords.end(), X.data());
   }
   build_blocks();
-  if (model_.time.mass_scaling_dt > 0) apply_mass_scaling();
   assemble_mass();
+  {  // gravity acts on the physical mass only: mass scaling adds inertia, not weight
+    auto M = mass.view();
+    gravity_mass_.assign(M.data(), M.data() + 3 * n);
+  }
+  if (model_.time.mass_scaling_dt > 0) {
+    apply_mass_scaling();
+    assemble_mass();
+  }
+  {
+    auto M = mass.view();
+    inv_mass_.resize(3 * n);
+    for (std::size_t d = 0; d < 3 * n; ++d) inv_mass_[d] = 1.0 / M[d];
+  }
 
   fixed_mask_.assign(3 * n, 0);
   for (const auto& fx : model_.fixed)
@@ -269,7 +281,13 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   auto Fd = f_damp.view();
   auto Rr = reaction.view();
   double* fi = Fi.data();
-  for (std::size_t d = 0; d < nd; ++d) fi[d] = 0.0, Fe[d] = 0.0, Fc[d] = 0.0;
+  // Arrays a model does not use stay zero and are neither cleared nor read in the node loop.
+  const bool has_ext = !model_.loads.empty() || model_.gravity.x != 0 || model_.gravity.y != 0 || model_.gravity.z != 0;
+  const bool has_contact = !model_.tools.empty() || !model_.contacts.empty();
+  const bool has_damp = model_.mass_damping != 0;
+  std::fill(fi, fi + nd, 0.0);
+  if (has_ext) std::fill(Fe.data(), Fe.data() + nd, 0.0);
+  if (has_contact) std::fill(Fc.data(), Fc.data() + nd, 0.0);
 
   // Internal forces at x^n from v^{n-1/2}.
   ElementEnergyIncrement inc;
@@ -306,9 +324,9 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   const V3 g = model_.gravity;
   if (g.x != 0 || g.y != 0 || g.z != 0)
     for (std::size_t i = 0; i < n; ++i)
-      Fe[3 * i] += M[3 * i] * g.x, Fe[3 * i + 1] += M[3 * i + 1] * g.y, Fe[3 * i + 2] += M[3 * i + 2] * g.z;
+      Fe[3 * i] += gravity_mass_[3 * i] * g.x, Fe[3 * i + 1] += gravity_mass_[3 * i + 1] * g.y,
+      Fe[3 * i + 2] += gravity_mass_[3 * i + 2] * g.z;
   const double alpha = model_.mass_damping;
-  for (std::size_t d = 0; d < nd; ++d) Fd[d] = -alpha * M[d] * Vv[d];
 
   if (dt_new < model_.time.min_step_ratio * dt_initial_) {
     std::ostringstream os;
@@ -329,26 +347,38 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   // v^{n+1/2}; works of each force kind over the increments around t^n.
   const double dt_mid = 0.5 * (dt_prev_ + dt_new);
   double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
+  // Without a callback the position update joins this loop (one pass over the nodal arrays).
+  double* xfused = at_tn ? nullptr : X.data();
+  const double* inv_m = inv_mass_.data();
+  const double* fe = has_ext ? Fe.data() : nullptr;
+  const double* fcon = has_contact ? Fc.data() : nullptr;
+  double* fdamp = has_damp ? Fd.data() : nullptr;
+  double* rr = Rr.data();
+  const std::uint8_t* mask = fixed_mask_.data();
   for (std::size_t d = 0; d < nd; ++d) {
-    const double vo = Vv[d];
-    const double ftot = fi[d] + Fe[d] + Fc[d] + Fd[d];
-    double vn = vo + dt_mid * ftot / M[d];
-    const std::uint8_t code = fixed_mask_[d];
+    const double vo = Vv[d], m = M[d];
+    const double fd = has_damp ? -alpha * m * vo : 0.0;
+    const double f_e = fe ? fe[d] : 0.0, f_c = fcon ? fcon[d] : 0.0;
+    double vn = vo + dt_mid * (fi[d] + f_e + f_c + fd) * inv_m[d];
     double r = 0;
-    if (code) {
+    if (const std::uint8_t code = mask[d]) {  // reactions stay zero on free DOFs
       const double vp = code == 1 ? 0.0 : vpres[code - 2].arr()[d % 3];
-      r = dt_mid > 0 ? M[d] * (vp - vn) / dt_mid : 0.0;
+      r = dt_mid > 0 ? m * (vp - vn) / dt_mid : 0.0;
       vn = vp;
+      rr[d] = r;
     }
-    Rr[d] = r;
     Vv[d] = vn;
     const double du_old = dt_prev_ * vo, du_new = dt_new * vn;
-    ext_old += (Fe[d] + r) * du_old, ext_new += (Fe[d] + r) * du_new;
-    damp_old += Fd[d] * du_old, damp_new += Fd[d] * du_new;
-    con_old += Fc[d] * du_old, con_new += Fc[d] * du_new;
+    if (xfused) xfused[d] += du_new;
+    ext_old += (f_e + r) * du_old, ext_new += (f_e + r) * du_new;
+    if (fdamp) {
+      fdamp[d] = fd;
+      damp_old += fd * du_old, damp_new += fd * du_new;
+    }
+    con_old += f_c * du_old, con_new += f_c * du_new;
     // Product form: with the trapezoidal works below, 1/2 v^{n-1/2} M v^{n+1/2} makes the
     // discrete energy balance of central differences exact for conservative forces.
-    ke += 0.5 * M[d] * vo * vn;
+    ke += 0.5 * m * vo * vn;
   }
   w_ext_.add(ext_old, ext_new);
   w_damp_.add(damp_old, damp_new);
@@ -402,8 +432,8 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     timers_.output += seconds_since(t0);
   }
 
-  // x^{n+1}
-  {
+  // x^{n+1} (already done in the velocity loop when there is no callback)
+  if (at_tn) {
     auto X = x.view();
     auto Vv = v.view();
     for (std::size_t d = 0; d < nd; ++d) X[d] += dt_new * Vv[d];

@@ -70,7 +70,9 @@ class ExplicitSolver {
   std::vector<PartMassReport> part_mass_;
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
-  std::vector<V3> vpres_;  // prescribed velocities at t^{n+1/2}, one per set
+  std::vector<V3> vpres_;
+  std::vector<double> inv_mass_;      // [3*n] 1 / lumped mass
+  std::vector<double> gravity_mass_;  // [3*n] physical nodal masses (no mass scaling)  // prescribed velocities at t^{n+1/2}, one per set
   std::int64_t cycle_ = 0;
   StableStep step_;
   EnergyBalance energy_;
