@@ -61,4 +61,29 @@ void hex8_output_fields(const Hex8Block& b, const double* x, double* cauchy, dou
   }
 }
 
+void hex8_fibre_direction(const Hex8Block& b, const double* x, std::size_t e, double out[3]) {
+  const std::size_t n = b.n;
+  double J[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+  for (int I = 0; I < 8; ++I) {
+    const std::size_t node = static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * n + e]);
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) J[3 * r + k] += 0.125 * S[k + 1][I] * x[3 * node + static_cast<std::size_t>(r)];
+  }
+  // F M e1 = J (J_ref^{-1} M e1)
+  double m1[3];
+  for (int k = 0; k < 3; ++k) {
+    double s = 0;
+    for (int j = 0; j < 3; ++j)
+      s += b.jac_inv0[static_cast<std::size_t>(3 * k + j) * n + e] * b.mat_axes[static_cast<std::size_t>(3 * j) * n + e];
+    m1[k] = s;
+  }
+  double len = 0;
+  for (int r = 0; r < 3; ++r) {
+    out[r] = J[3 * r] * m1[0] + J[3 * r + 1] * m1[1] + J[3 * r + 2] * m1[2];
+    len += out[r] * out[r];
+  }
+  len = std::sqrt(len);
+  for (int r = 0; r < 3; ++r) out[r] /= len;
+}
+
 }  // namespace ncfsim::fem

@@ -13,6 +13,9 @@ namespace ncfsim::fem {
 /// fibre [n][3] (unit vector of material axis 1 pushed forward by F).
 void hex8_output_fields(const Hex8Block& b, const double* x, double* cauchy, double* von_mises, double* fibre);
 
+/// Unit vector of material axis 1 of element e pushed forward by F (the current fibre direction).
+void hex8_fibre_direction(const Hex8Block& b, const double* x, std::size_t e, double out[3]);
+
 /// Von Mises equivalent of a symmetric stress (xx yy zz xy yz xz).
 double von_mises(const double s[6]);
 

@@ -11,6 +11,7 @@
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
 #include "workflow/calibrate/calibrate_stitch.hpp"
+#include "workflow/calibrate/calibrate_tow_bending.hpp"
 #include "workflow/case/engine_case.hpp"
 #include "workflow/figures/figures.hpp"
 #include "workflow/report/report.hpp"
@@ -89,6 +90,18 @@ int main(int argc, char** argv) {
   cal_stitch->add_option("--name", sc.law_name, "Name of the [[bar_law]] (default stitch)");
   cal_stitch->add_option("-o,--output", sc.out_dir, "Output folder (default stitch_calibration)");
 
+  wf::TowBendingCalibration tb;
+  auto* cal_bend = calibrate->add_subcommand(
+      "tow-bending", "Tow fibre modulus E11f that gives a target ASTM D1388 bending length in the "
+                     "virtual cantilever test (the case needs an [[output.bending_length]] probe)");
+  cal_bend->add_option("case", tb.case_file, "Cantilever-bending case (TOML)")->required()->check(CLI::ExistingFile);
+  cal_bend->add_option("--target-bending-length", tb.target_bending_length, "Measured bending length c, m")
+      ->required()->check(CLI::PositiveNumber);
+  cal_bend->add_option("--tolerance", tb.tolerance, "Relative tolerance on c (default 0.01)")->check(CLI::Range(1e-4, 0.2));
+  cal_bend->add_option("--max-runs", tb.max_runs, "Most simulation runs (default 6)")->check(CLI::Range(1, 50));
+  cal_bend->add_option("--set", tb.overrides, "Override a case key (repeatable)");
+  cal_bend->add_option("-o,--output", tb.out_dir, "Output folder (default tow_bending_calibration)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -125,6 +138,14 @@ int main(int argc, char** argv) {
       std::printf("%s: stitch_law.csv, stitch_law.toml, figures/stitch_law.png, figures/stitch_fit.png\n",
                   sc.out_dir.c_str());
       return wf::kSuccess;
+    }
+    if (*cal_bend) {
+      ncfsim::fem::PetscSession petsc;
+      const auto r = wf::calibrate_tow_bending(tb);
+      std::printf("E11f = %.6g Pa gives a bending length of %.6g m (target %.6g m) after %d runs%s; see %s\n", r.E11f,
+                  r.bending_length, tb.target_bending_length, r.runs, r.converged ? "" : " (NOT converged)",
+                  (tb.out_dir / "calibration.json").c_str());
+      return r.converged ? wf::kSuccess : wf::kNumericalFailure;
     }
     if (*render) {
       require_output_folder(folder);

@@ -246,3 +246,31 @@ TEST(Cli, CalibrateStitchRoundTrip) {
   EXPECT_NE(bad.output.find("extension_m"), std::string::npos) << bad.output;
   fs::remove_all(dir);
 }
+
+// Virtual cantilever bending (ASTM D1388) of one tow: the bending length from the tip angle matches
+// beam theory c = (E1 t^3 / 12 / w)^(1/3) of the tow's modulus within 5 %; the calibration command
+// finds the E11f that gives a target bending length (within its 1 % tolerance) and the bending
+// length of that modulus still matches beam theory within 5 %.
+TEST(CliRegression, CantileverBendingMatchesBeamTheoryAndCalibrates) {
+  const fs::path out = fresh_dir("bending");
+  const fs::path case_file = kSource / "cases/drape/cantilever_bending.toml";
+  Result r = run_cli({"-q", "run", case_file.string(), "-o", out.string(), "--set", "mesh.resolution=coarse",
+                      "--set", "output.figures=false", "--set", "output.report=false"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+  const double c = s["tow_bending_length_m"].get<double>(), beam = s["tow_beam_theory_bending_length_m"].get<double>();
+  EXPECT_NEAR(c, beam, 0.05 * beam);
+  EXPECT_NEAR(s["tow_tip_angle_deg"].get<double>(), 41.5, 5.0) << "the overhang is about twice the bending length";
+
+  const double target = 0.028;
+  r = run_cli({"calibrate", "tow-bending", case_file.string(), "--target-bending-length", std::to_string(target),
+               "--set", "mesh.resolution=coarse", "-o", (out / "calibration").string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto cal = nlohmann::json::parse(slurp(out / "calibration/calibration.json"));
+  EXPECT_TRUE(cal["converged"].get<bool>());
+  EXPECT_NEAR(cal["bending_length_m"].get<double>(), target, 0.01 * target);
+  const auto& last = cal["runs"].back();
+  EXPECT_NEAR(last["bending_length_m"].get<double>(), last["beam_theory_bending_length_m"].get<double>(),
+              0.05 * last["beam_theory_bending_length_m"].get<double>());
+  fs::remove_all(out);
+}

@@ -7,6 +7,8 @@
 #include "drape/fabric_generator.hpp"
 #include "drape/stitch_connection.hpp"
 #include "drape/tow_material.hpp"
+#include "fem/contact/penalty_contact.hpp"
+#include "fem/contact/tied_contact.hpp"
 #include "fem/errors.hpp"
 #include "fem/mesh.hpp"
 #include "workflow/case/toml_reader.hpp"
@@ -226,6 +228,77 @@ void read_tools(const TableReader& root, EngineCase& ec, const std::string& file
     tool.thickness = t.number("thickness", 0.0, Range::non_negative());
     tool.contact_nodes = select_nodes(t, "contact_nodes", ec.model.mesh);
     ec.model.tools.push_back(std::move(tool));
+  }
+}
+
+std::vector<int> part_indices(const TableReader& t, std::string_view key, const fem::Mesh& mesh) {
+  std::vector<int> out;
+  for (const auto& name : t.strings(key)) {
+    const int p = mesh.find_part(name);
+    if (p < 0) t.fail(key, "no part named '" + name + "'");
+    out.push_back(p);
+  }
+  if (out.empty()) t.fail(key, "needs at least one part");
+  return out;
+}
+
+// Deformable contacts: penalty (groups of parts and pairs with a friction coefficient) and tied.
+void read_contacts(const TableReader& root, EngineCase& ec, const std::string& file) {
+  const fem::Mesh& mesh = ec.model.mesh;
+  for (const auto& t : root.tables("contact")) {
+    const std::string type = t.choice("type", {"penalty", "tied"}, "penalty");
+    const std::string name = t.string("name");
+    try {
+      if (type == "penalty") {
+        fem::PenaltyContactConfig c;
+        c.name = name;
+        c.source_file = file;
+        c.penalty_scale = t.number("penalty_scale", c.penalty_scale, Range::open_closed(0, 0.5));
+        c.thickness = t.number("thickness", 0.0, Range::non_negative());
+        c.search_margin = t.number("search_margin", 0.0, Range::non_negative());
+        c.edge_tolerance = t.number("edge_tolerance", c.edge_tolerance, Range::closed(0, 0.5));
+        c.max_penetration = t.number("max_penetration", c.max_penetration, Range::open_closed(0, 1));
+        std::map<std::string, int> groups;
+        for (const auto& g : t.tables("group")) {
+          fem::ContactGroup cg;
+          cg.name = g.string("name");
+          if (groups.count(cg.name)) g.fail("name", "duplicate contact group '" + cg.name + "'");
+          cg.parts = part_indices(g, "parts", mesh);
+          groups[cg.name] = static_cast<int>(c.groups.size());
+          c.groups.push_back(std::move(cg));
+        }
+        if (c.groups.empty()) t.fail("group", "a penalty contact needs at least one [[contact.group]]");
+        for (const auto& pr : t.tables("pair")) {
+          const auto names = pr.strings("groups");
+          if (names.size() != 2) pr.fail("groups", "must name exactly 2 groups (the same twice for self-contact)");
+          fem::ContactPair cp;
+          for (int k = 0; k < 2; ++k) {
+            const auto it = groups.find(names[static_cast<std::size_t>(k)]);
+            if (it == groups.end()) pr.fail("groups", "no [[contact.group]] named '" + names[static_cast<std::size_t>(k)] + "'");
+            (k == 0 ? cp.first : cp.second) = it->second;
+          }
+          cp.friction = pr.number("friction", 0.0, Range::non_negative());
+          c.pairs.push_back(cp);
+        }
+        if (c.pairs.empty()) t.fail("pair", "a penalty contact needs at least one [[contact.pair]]");
+        ec.model.contacts.push_back(std::make_unique<fem::PenaltyContact>(std::move(c)));
+      } else {
+        fem::TiedContactConfig c;
+        c.name = name;
+        c.source_file = file;
+        c.slave = {name + "_slave", part_indices(t, "slave_parts", mesh)};
+        c.master = {name + "_master", part_indices(t, "master_parts", mesh)};
+        c.penalty_scale = t.number("penalty_scale", c.penalty_scale, Range::open_closed(0, 0.5));
+        c.search_distance = t.number("search_distance", 0.0, Range::non_negative());
+        c.normal_strength = t.number("normal_strength", 0.0, Range::non_negative());
+        c.shear_strength = t.number("shear_strength", 0.0, Range::non_negative());
+        ec.model.contacts.push_back(std::make_unique<fem::TiedContact>(std::move(c)));
+      }
+    } catch (const InputError& e) {
+      throw;
+    } catch (const std::invalid_argument& e) {
+      t.fail("type", e.what());
+    }
   }
 }
 
@@ -472,6 +545,7 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       ec.model.initial_velocities.push_back({select_nodes(t, "nodes", mesh), to_v3(t.vec3("velocity"))});
 
   read_tools(root, ec, fname);
+  read_contacts(root, ec, fname);
 
   // Time controls.
   const TableReader tc = root.required_table("time");
@@ -492,6 +566,46 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
     ec.output.figures = o->boolean("figures", true);
     ec.output.report = o->boolean("report", false);
     for (const auto& t : o->tables("probe")) ec.probes.push_back({t.string("name"), select_nodes(t, "nodes", mesh)});
+    for (const auto& t : o->tables("shear_probe")) {
+      ShearProbe sp;
+      sp.name = t.string("name");
+      const auto parts = t.strings("parts");
+      if (parts.size() != 2) t.fail("parts", "must name exactly 2 parts (the two plies)");
+      sp.part_a = mesh.find_part(parts[0]);
+      sp.part_b = mesh.find_part(parts[1]);
+      if (sp.part_a < 0 || sp.part_b < 0) t.fail("parts", "no part named '" + parts[sp.part_a < 0 ? 0 : 1] + "'");
+      sp.box_min = t.vec3("box_min");
+      sp.box_max = t.vec3("box_max");
+      ec.shear_probes.push_back(sp);
+    }
+    for (const auto& t : o->tables("bending_length")) {
+      BendingLengthProbe bp;
+      bp.name = t.string("name");
+      bp.part = mesh.find_part(t.string("part"));
+      if (bp.part < 0) t.fail("part", "no such part");
+      bp.root = select_nodes(t, "root", mesh);
+      bp.tip = select_nodes(t, "tip", mesh);
+      ec.bending.push_back(std::move(bp));
+    }
+    for (const auto& t : o->tables("sample")) {
+      SummarySamples ss;
+      ss.x = t.string("x");
+      ss.x_display_scale = t.number("x_display_scale", 1e3, Range::positive());
+      ss.x_unit = t.string("x_unit", "mm");
+      ss.at = t.numbers("at", {}, 1);
+      if (auto cols = t.table("columns")) {
+        for (const auto& [k, v] : doc.root().at_path(cols->path()).as_table() ? *doc.root().at_path(cols->path()).as_table() : toml::table{})
+          ss.columns.emplace_back(std::string(k.str()), cols->string(k.str()));
+      }
+      const std::string analytic = t.choice("analytic", {"none", "bias_extension"}, "none");
+      if (analytic == "bias_extension") {
+        ss.bias_extension_analytic = true;
+        ss.coupon_length = t.number("coupon_length", Range::positive());
+        ss.coupon_width = t.number("coupon_width", Range::positive());
+        if (!(ss.coupon_length > ss.coupon_width)) t.fail("coupon_length", "must exceed coupon_width");
+      }
+      ec.samples.push_back(std::move(ss));
+    }
   }
   if (auto f = root.table("figures")) {
     for (const auto& t : f->tables("plot")) {

@@ -22,6 +22,38 @@ struct ReactionProbe {
   std::vector<std::int32_t> nodes;
 };
 
+/// In-plane shear angle between the fibres of two plies over the elements whose reference centroid
+/// lies in a box (a material region): 90 deg minus the angle between the mean fibre directions.
+/// history.csv: <name>_shear_angle_deg.
+struct ShearProbe {
+  std::string name;
+  int part_a = -1, part_b = -1;
+  std::array<double, 3> box_min{}, box_max{};
+};
+
+/// Values of history columns at given values of another column, into summary.json as
+/// <label>_at_<x in display units><unit> (e.g. force_N_at_10mm). `analytic` adds the bias-extension
+/// shear angle of Eq. 2 (analytic_shear_angle_deg_at_...).
+struct SummarySamples {
+  std::string x;                    // history column, e.g. clamp_displacement_x_m
+  double x_display_scale = 1e3;     // 1e3: the keys name mm
+  std::string x_unit = "mm";
+  std::vector<double> at;           // in display units
+  std::vector<std::pair<std::string, std::string>> columns;  // label -> history column
+  bool bias_extension_analytic = false;
+  double coupon_length = 0, coupon_width = 0;  // m (free length H, width W)
+};
+
+/// ASTM D1388 cantilever bending of a strip clamped at `root` and overhanging to `tip` under
+/// gravity: tip angle theta below the horizontal, bending length c = O (cos(theta/2) / (8 tan
+/// theta))^(1/3), flexural rigidity G = w c^3 (w = weight per area), and the beam-theory c of the
+/// part's material, (E1 t^3 / 12 / w)^(1/3). history.csv: <name>_tip_angle_deg.
+struct BendingLengthProbe {
+  std::string name;
+  int part = -1;
+  std::vector<std::int32_t> root, tip;
+};
+
 struct OutputSettings {
   bool xdmf = true;           // results.h5 + results.xdmf
   bool vtu = false;           // frames/*.vtu + results.pvd
@@ -86,6 +118,9 @@ struct EngineCase {
   std::vector<PlotSpec> plots;
   std::vector<PictureSpec> pictures;
   std::vector<FabricSummary> fabric_summaries;
+  std::vector<ShearProbe> shear_probes;
+  std::vector<SummarySamples> samples;
+  std::vector<BendingLengthProbe> bending;
 };
 
 /// Reads and checks a case (throws InputError naming file and key). `overrides` are --set items.

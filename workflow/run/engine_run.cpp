@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <spdlog/logger.h>
 
+#include "drape/stitch_calibration.hpp"
 #include "fem/element_fields.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/result_writers.hpp"
@@ -208,7 +209,9 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   }
   for (const auto& r : ec.reactions) hc.add_xyz(r.name + "_reaction", "N");
   for (const auto& p : ec.probes) hc.add_xyz(p.name + "_displacement", "m");
-  HistoryWriter history(dir / "history.csv", hc.names);
+  // Contact resultants are named by the contacts once they have run a cycle: the header is
+  // written with the first row.
+  std::unique_ptr<HistoryWriter> history;
 
   auto probe_disp = [&](const std::vector<std::int32_t>& nodes) {
     auto X = solver.x.view();
@@ -220,6 +223,103 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     }
     return (1.0 / static_cast<double>(nodes.size())) * s;
   };
+  // Shear probes: the hexahedra (block, element) of each ply whose reference centroid is in the box.
+  struct ProbeElements {
+    std::vector<std::pair<std::size_t, std::size_t>> a, b;
+  };
+  std::vector<ProbeElements> shear_sets;
+  {
+    auto X0 = solver.x0.view();
+    for (const auto& sp : ec.shear_probes) {
+      ProbeElements pe;
+      for (std::size_t k = 0; k < solver.hex_blocks().size(); ++k) {
+        const auto& b = solver.hex_blocks()[k];
+        if (b.part != sp.part_a && b.part != sp.part_b) continue;
+        for (std::size_t e = 0; e < b.n; ++e) {
+          double c[3] = {0, 0, 0};
+          for (int I = 0; I < 8; ++I)
+            for (int r = 0; r < 3; ++r)
+              c[r] += 0.125 * X0[3 * static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * b.n + e]) + static_cast<std::size_t>(r)];
+          bool in = true;
+          for (int r = 0; r < 3; ++r) in &= c[r] >= sp.box_min[static_cast<std::size_t>(r)] && c[r] <= sp.box_max[static_cast<std::size_t>(r)];
+          if (in) (b.part == sp.part_a ? pe.a : pe.b).emplace_back(k, e);
+        }
+      }
+      if (pe.a.empty() || pe.b.empty())
+        throw InputError(ec.file.string(), "output.shear_probe." + sp.name,
+                         "the box holds no element of one of the two parts");
+      log->info("shear probe {}: {} + {} elements", sp.name, pe.a.size(), pe.b.size());
+      shear_sets.push_back(std::move(pe));
+      hc.add(sp.name + "_shear_angle_deg");
+    }
+  }
+  auto shear_angle = [&](const ProbeElements& pe) {
+    auto X = solver.x.view();
+    auto mean = [&](const std::vector<std::pair<std::size_t, std::size_t>>& set) {
+      V3 s, first;
+      for (const auto& [k, e] : set) {
+        double d[3];
+        fem::hex8_fibre_direction(solver.hex_blocks()[k], X.data(), e, d);
+        V3 v{d[0], d[1], d[2]};
+        if (norm(first) == 0) first = v;
+        s += dot(v, first) < 0 ? -1.0 * v : v;  // a fibre direction has no sign
+      }
+      return normalized(s);
+    };
+    const double c = std::abs(dot(mean(pe.a), mean(pe.b)));
+    return 90.0 - std::acos(std::min(1.0, c)) * 180.0 / M_PI;
+  };
+  // Cantilever bending (ASTM D1388) probes.
+  struct BendingState {
+    double overhang = 0, thickness = 0, width = 0, areal_mass = 0, E1 = 0;
+  };
+  std::vector<BendingState> bending_state;
+  {
+    auto X0 = solver.x0.view();
+    for (const auto& bp : ec.bending) {
+      BendingState bs;
+      double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+      for (std::size_t e = 0; e < model.mesh.hexes.size(); ++e)
+        if (model.mesh.hex_part[e] == bp.part)
+          for (auto nd : model.mesh.hexes[e])
+            for (int r = 0; r < 3; ++r) {
+              lo[r] = std::min(lo[r], X0[3 * static_cast<std::size_t>(nd) + static_cast<std::size_t>(r)]);
+              hi[r] = std::max(hi[r], X0[3 * static_cast<std::size_t>(nd) + static_cast<std::size_t>(r)]);
+            }
+      bs.overhang = hi[0] - lo[0], bs.width = hi[1] - lo[1], bs.thickness = hi[2] - lo[2];
+      bs.areal_mass = solver.part_masses()[static_cast<std::size_t>(bp.part)].mass / (bs.overhang * bs.width);
+      const auto& pp = model.parts[static_cast<std::size_t>(bp.part)];
+      const auto moduli = fem::directional_moduli(model.materials[static_cast<std::size_t>(pp.material)]->elastic_stiffness(),
+                                                  {1, 0, 0, 0, 1, 0, 0, 0, 1});
+      bs.E1 = moduli[0];  // along material axis 1
+      bending_state.push_back(bs);
+      hc.add(bp.name + "_tip_angle_deg");
+    }
+  }
+  auto tip_angle = [&](const BendingLengthProbe& bp) {
+    const V3 r = probe_disp(bp.root), t = probe_disp(bp.tip);
+    auto X0 = solver.x0.view();
+    V3 r0, t0;
+    for (auto i : bp.root) r0 += V3::at(X0.data() + 3 * static_cast<std::size_t>(i));
+    for (auto i : bp.tip) t0 += V3::at(X0.data() + 3 * static_cast<std::size_t>(i));
+    r0 = (1.0 / static_cast<double>(bp.root.size())) * r0 + r;
+    t0 = (1.0 / static_cast<double>(bp.tip.size())) * t0 + t;
+    return std::atan2(-(t0.z - r0.z), t0.x - r0.x);  // rad below the horizontal
+  };
+  std::vector<std::vector<double>> kept_rows;  // for summary samples
+  // Eq. 2 beside the simulated shear angle, as a history column, when a sample asks for it.
+  const SummarySamples* analytic = nullptr;
+  for (const auto& ss : ec.samples)
+    if (ss.bias_extension_analytic) analytic = &ss;
+  int analytic_x = -1;
+  if (analytic) {
+    for (std::size_t c = 0; c < hc.names.size(); ++c)
+      if (hc.names[c] == analytic->x) analytic_x = static_cast<int>(c);
+    if (analytic_x < 0)
+      throw InputError(ec.file.string(), "output.sample.x", "no history column '" + analytic->x + "' (probes: <name>_displacement_x_m)");
+    hc.add("analytic_shear_angle_deg");
+  }
+
   double max_error = 0;
   auto history_row = [&] {
     const auto& en = solver.energy();
@@ -237,7 +337,22 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
       for (double v : solver.reaction_force(r.nodes).arr()) row.push_back(v);
     for (const auto& p : ec.probes)
       for (double v : probe_disp(p.nodes).arr()) row.push_back(v);
-    history.write_row(row);
+    for (const auto& pe : shear_sets) row.push_back(shear_angle(pe));
+    for (const auto& bp : ec.bending) row.push_back(tip_angle(bp) * 180.0 / M_PI);
+    if (analytic) {
+      drape::BiasExtensionCoupon coupon;
+      coupon.length = analytic->coupon_length, coupon.width = analytic->coupon_width;
+      row.push_back(drape::central_shear_angle(coupon, std::max(0.0, row[static_cast<std::size_t>(analytic_x)])) * 180.0 / M_PI);
+    }
+    for (const auto& c : model.contacts)
+      for (const auto& r : c->resultants()) {
+        for (double v : r.force.arr()) row.push_back(v);
+        if (!history) hc.add_xyz(r.name + "_force", "N");
+      }
+    if (!history) history = std::make_unique<HistoryWriter>(dir / "history.csv", hc.names);
+    row.resize(hc.names.size(), std::numeric_limits<double>::quiet_NaN());  // a resultant that came later
+    history->write_row(row);
+    if (!ec.samples.empty()) kept_rows.push_back(row);
   };
 
   // Frames.
@@ -292,6 +407,49 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     for (const auto& p : ec.probes) {
       const V3 d = probe_disp(p.nodes);
       summary[p.name + "_displacement_m"] = {d.x, d.y, d.z};
+    }
+    for (std::size_t k = 0; k < ec.bending.size(); ++k) {
+      const auto& bp = ec.bending[k];
+      const auto& bs = bending_state[k];
+      const double theta = tip_angle(bp), g = norm(model.gravity);
+      const double c = theta > 0 ? bs.overhang * std::cbrt(std::cos(theta / 2) / (8 * std::tan(theta))) : std::nan("");
+      summary[bp.name + "_overhang_m"] = bs.overhang;
+      summary[bp.name + "_tip_angle_deg"] = theta * 180.0 / M_PI;
+      summary[bp.name + "_bending_length_m"] = std::isfinite(c) ? nlohmann::json(c) : nlohmann::json(nullptr);
+      summary[bp.name + "_flexural_rigidity_Nm"] = std::isfinite(c) ? nlohmann::json(bs.areal_mass * g * c * c * c) : nlohmann::json(nullptr);
+      summary[bp.name + "_beam_theory_bending_length_m"] =
+          std::cbrt(bs.E1 * bs.thickness * bs.thickness * bs.thickness / 12.0 / (bs.areal_mass * g));
+      summary[bp.name + "_axial_modulus_Pa"] = bs.E1;
+    }
+    for (const auto& ss : ec.samples) {
+      const auto col = [&](const std::string& name) -> int {
+        for (std::size_t c = 0; c < hc.names.size(); ++c)
+          if (hc.names[c] == name) return static_cast<int>(c);
+        return -1;
+      };
+      const int cx = col(ss.x);
+      for (double at : ss.at) {
+        const std::string tag = fmt::format("_at_{:g}{}", at, ss.x_unit);
+        const double xv = at / ss.x_display_scale;
+        for (const auto& [label, column] : ss.columns) {
+          const int cy = col(column);
+          double val = std::numeric_limits<double>::quiet_NaN();
+          for (std::size_t r = 1; cx >= 0 && cy >= 0 && r < kept_rows.size(); ++r) {
+            const double x0 = kept_rows[r - 1][static_cast<std::size_t>(cx)], x1 = kept_rows[r][static_cast<std::size_t>(cx)];
+            if ((x0 - xv) * (x1 - xv) <= 0 && x1 != x0) {
+              const double w = (xv - x0) / (x1 - x0);
+              val = (1 - w) * kept_rows[r - 1][static_cast<std::size_t>(cy)] + w * kept_rows[r][static_cast<std::size_t>(cy)];
+              break;
+            }
+          }
+          summary[label + tag] = std::isfinite(val) ? nlohmann::json(val) : nlohmann::json(nullptr);
+        }
+        if (ss.bias_extension_analytic) {
+          drape::BiasExtensionCoupon coupon;
+          coupon.length = ss.coupon_length, coupon.width = ss.coupon_width;
+          summary["analytic_shear_angle_deg" + tag] = drape::central_shear_angle(coupon, xv) * 180.0 / M_PI;
+        }
+      }
     }
     const auto& tm = solver.timers();
     summary["timers_s"] = {{"internal_force", tm.internal_force}, {"contact", tm.contact},

@@ -1,0 +1,142 @@
+#include "fem/contact/contact_surface.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+
+#include "fem/errors.hpp"
+#include "fem/vec3.hpp"
+
+namespace ncfsim::fem {
+
+namespace {
+
+// Faces of the VTK hexahedron, corners counter-clockwise seen from outside (outward normal by
+// the right-hand rule), and the face opposite each.
+constexpr int kFace[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                             {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+constexpr int kOpposite[6] = {1, 0, 4, 5, 2, 3};
+
+struct FaceRecord {
+  std::array<std::int32_t, 4> key;  // sorted corners
+  std::int32_t hex;
+  std::int32_t face;
+  bool operator<(const FaceRecord& o) const { return key < o.key; }
+};
+
+V3 node_at(const double* x, std::int32_t i) { return V3::at(x + 3 * static_cast<std::size_t>(i)); }
+
+}  // namespace
+
+ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<ContactGroup>& groups,
+                                       const double* x0, const std::string& file,
+                                       const std::string& key_prefix) {
+  const std::string key = key_prefix + ".groups";
+  const auto n_parts = static_cast<int>(mesh.part_names.size());
+  std::vector<int> group_of_part(static_cast<std::size_t>(n_parts), -1);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (groups[g].parts.empty())
+      throw InputError(file, key, "group '" + groups[g].name + "' lists no parts");
+    for (int p : groups[g].parts) {
+      if (p < 0 || p >= n_parts)
+        throw InputError(file, key,
+                         "group '" + groups[g].name + "' names part index " + std::to_string(p) +
+                             ", outside 0.." + std::to_string(n_parts - 1));
+      auto& owner = group_of_part[static_cast<std::size_t>(p)];
+      if (owner >= 0 && owner != static_cast<int>(g))
+        throw InputError(file, key,
+                         "part '" + mesh.part_names[static_cast<std::size_t>(p)] +
+                             "' is in groups '" + groups[static_cast<std::size_t>(owner)].name +
+                             "' and '" + groups[g].name + "' of one contact");
+      owner = static_cast<int>(g);
+    }
+  }
+  std::vector<std::size_t> hexes_of_part(static_cast<std::size_t>(n_parts), 0);
+  for (auto p : mesh.hex_part) ++hexes_of_part[static_cast<std::size_t>(p)];
+  for (const auto& grp : groups)
+    for (int p : grp.parts)
+      if (hexes_of_part[static_cast<std::size_t>(p)] == 0)
+        throw InputError(file, key,
+                         "part '" + mesh.part_names[static_cast<std::size_t>(p)] + "' of group '" +
+                             grp.name + "' holds no hexahedra (contact surfaces are hex faces)");
+
+  ContactSurface s;
+  std::vector<std::int32_t> seg_hex;
+  std::vector<FaceRecord> faces;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    faces.clear();
+    for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
+      if (group_of_part[static_cast<std::size_t>(mesh.hex_part[e])] != static_cast<int>(g))
+        continue;
+      for (int f = 0; f < 6; ++f) {
+        FaceRecord r;
+        for (int k = 0; k < 4; ++k) r.key[k] = mesh.hexes[e][kFace[f][k]];
+        std::sort(r.key.begin(), r.key.end());
+        r.hex = static_cast<std::int32_t>(e);
+        r.face = f;
+        faces.push_back(r);
+      }
+    }
+    std::sort(faces.begin(), faces.end());
+    for (std::size_t i = 0; i < faces.size();) {
+      std::size_t j = i + 1;
+      while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+      if (j == i + 1) {  // used by exactly one hexahedron of the group: an outer face
+        const auto& h = mesh.hexes[static_cast<std::size_t>(faces[i].hex)];
+        const int f = faces[i].face;
+        V3 c, co;
+        for (int k = 0; k < 4; ++k) {
+          c += 0.25 * node_at(x0, h[kFace[f][k]]);
+          co += 0.25 * node_at(x0, h[kFace[kOpposite[f]][k]]);
+        }
+        const V3 a = node_at(x0, h[kFace[f][2]]) - node_at(x0, h[kFace[f][0]]);
+        const V3 b = node_at(x0, h[kFace[f][3]]) - node_at(x0, h[kFace[f][1]]);
+        const V3 n = normalized(cross(a, b));
+        for (int k = 0; k < 4; ++k) s.seg_nodes.push_back(h[kFace[f][k]]);
+        for (int k = 0; k < 8; ++k) s.seg_elem_nodes.push_back(h[k]);
+        s.seg_group.push_back(static_cast<std::int32_t>(g));
+        s.seg_elem_thickness.push_back(std::abs(dot(co - c, n)));
+        s.seg_elem_user_id.push_back(mesh.hex_user_id.size() == mesh.hexes.size()
+                                         ? mesh.hex_user_id[static_cast<std::size_t>(faces[i].hex)]
+                                         : faces[i].hex + 1);
+        seg_hex.push_back(faces[i].hex);
+      }
+      i = j;
+    }
+  }
+
+  // Surface nodes: unique (node, group), sorted.
+  const std::size_t n_seg = s.n_segments();
+  std::vector<std::int64_t> keys(4 * n_seg);
+  const auto n_groups = static_cast<std::int64_t>(std::max<std::size_t>(groups.size(), 1));
+  for (std::size_t q = 0; q < n_seg; ++q)
+    for (int k = 0; k < 4; ++k)
+      keys[4 * q + k] =
+          static_cast<std::int64_t>(s.seg_nodes[4 * q + k]) * n_groups + s.seg_group[q];
+  std::vector<std::int64_t> uniq = keys;
+  std::sort(uniq.begin(), uniq.end());
+  uniq.erase(std::unique(uniq.begin(), uniq.end()), uniq.end());
+  s.node.resize(uniq.size());
+  s.node_group.resize(uniq.size());
+  for (std::size_t i = 0; i < uniq.size(); ++i) {
+    s.node[i] = static_cast<std::int32_t>(uniq[i] / n_groups);
+    s.node_group[i] = static_cast<std::int32_t>(uniq[i] % n_groups);
+  }
+  s.seg_surface_node.resize(4 * n_seg);
+  s.node_area.assign(uniq.size(), 0.0);
+  for (std::size_t q = 0; q < n_seg; ++q) {
+    const V3 a = node_at(x0, s.seg_nodes[4 * q + 2]) - node_at(x0, s.seg_nodes[4 * q]);
+    const V3 b = node_at(x0, s.seg_nodes[4 * q + 3]) - node_at(x0, s.seg_nodes[4 * q + 1]);
+    const double area = 0.5 * norm(cross(a, b));
+    for (int k = 0; k < 4; ++k) {
+      const auto it = std::lower_bound(uniq.begin(), uniq.end(), keys[4 * q + k]);
+      const auto i = static_cast<std::size_t>(it - uniq.begin());
+      s.seg_surface_node[4 * q + k] = static_cast<std::int32_t>(i);
+      s.node_area[i] += 0.25 * area;
+    }
+  }
+  return s;
+}
+
+}  // namespace ncfsim::fem

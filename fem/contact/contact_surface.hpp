@@ -1,0 +1,39 @@
+#pragma once
+// Contact surfaces: the outer faces (quadrilateral segments) of the hexahedra of the parts of
+// each contact group, and the surface nodes. Built once before the time loop.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fem/contact/contact_config.hpp"
+#include "fem/mesh.hpp"
+
+namespace ncfsim::fem {
+
+/// Segments and surface nodes of a list of groups. A mesh node on the surface of two groups gets
+/// one surface-node entry per group. Surface nodes are sorted by (mesh node, group), so a loop
+/// over them walks the nodal arrays forwards.
+struct ContactSurface {
+  std::vector<std::int32_t> seg_nodes;         // [n_seg][4] mesh nodes, CCW seen from outside
+  std::vector<std::int32_t> seg_group;         // [n_seg] group index
+  std::vector<std::int32_t> seg_elem_nodes;    // [n_seg][8] nodes of the hexahedron owning the face
+  std::vector<std::int32_t> seg_surface_node;  // [n_seg][4] surface-node entry of each corner
+  std::vector<double>
+      seg_elem_thickness;  // [n_seg] owning hexahedron's thickness normal to the face at x0, m
+  std::vector<std::int64_t> seg_elem_user_id;  // [n_seg] for messages
+  std::vector<std::int32_t> node;              // [n_snode] mesh node of each surface node
+  std::vector<std::int32_t> node_group;        // [n_snode] group of each surface node
+  std::vector<double> node_area;  // [n_snode] tributary area at x0 (quarter of each segment), m^2
+
+  std::size_t n_segments() const { return seg_group.size(); }
+  std::size_t n_nodes() const { return node.size(); }
+};
+
+/// Outer faces of each group (faces used by exactly one hexahedron of the group's parts).
+/// Throws InputError(file, key_prefix + ".groups", ...) for a part index outside the mesh, a part
+/// without hexahedra, a part listed in two groups, or a group without parts.
+ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<ContactGroup>& groups,
+                                       const double* x0, const std::string& file,
+                                       const std::string& key_prefix);
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,397 @@
+#include "fem/contact/penalty_contact.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "fem/contact/contact_force_kernel.hpp"
+#include "fem/errors.hpp"
+
+namespace ncfsim::fem {
+
+namespace {
+// Facet normal . segment normal below which a node may touch a segment (opposed within 60 deg).
+constexpr double kOpposedNormals = -0.5;
+// Adjacent segment normals within 45 deg of a facet's mean normal belong to that facet.
+constexpr double kSameFacet = 0.7071;
+}  // namespace
+
+PenaltyContact::PenaltyContact(PenaltyContactConfig config) : cfg_(std::move(config)) {
+  validate(cfg_);
+}
+
+void PenaltyContact::initialise(const ContactSetup& setup) {
+  const std::string prefix = "contact." + cfg_.name;
+  if (!setup.mesh || !setup.x0 || !setup.mass || !(setup.dt > 0))
+    throw InputError(cfg_.source_file, prefix, "contact set up without mesh, masses or step");
+  surf_ = extract_contact_surface(*setup.mesh, cfg_.groups, setup.x0, cfg_.source_file, prefix);
+  n_groups_ = cfg_.groups.size();
+  const std::size_t ng = n_groups_, n_seg = surf_.n_segments(), n_node = surf_.n_nodes();
+  pair_of_.assign(ng * ng, -1);
+  mu_of_.assign(ng * ng, 0.0);
+  sign_of_.assign(ng * ng, 0.0);
+  for (std::size_t p = 0; p < cfg_.pairs.size(); ++p) {
+    const auto a = static_cast<std::size_t>(cfg_.pairs[p].first);
+    const auto b = static_cast<std::size_t>(cfg_.pairs[p].second);
+    for (auto [s, m] : {std::pair{a, b}, std::pair{b, a}}) {
+      pair_of_[s * ng + m] = static_cast<std::int32_t>(p);
+      mu_of_[s * ng + m] = cfg_.pairs[p].friction;
+      sign_of_[s * ng + m] = s == a ? 1.0 : -1.0;  // the slave is the first group, or its reaction
+    }
+  }
+  double t_min = std::numeric_limits<double>::max();
+  depth_.resize(n_seg);
+  for (std::size_t s = 0; s < n_seg; ++s) {
+    const double t = surf_.seg_elem_thickness[s];
+    if (!(t > 0))
+      throw InputError(cfg_.source_file, prefix,
+                       "hexahedron " + std::to_string(surf_.seg_elem_user_id[s]) +
+                           " has no thickness normal to one of its faces");
+    t_min = std::min(t_min, t);
+    depth_[s] = cfg_.max_penetration * t;
+  }
+  margin_ =
+      cfg_.search_margin > 0 ? cfg_.search_margin : cfg_.thickness + 0.5 * (n_seg ? t_min : 1.0);
+  inv_dt0_sq_ = 1.0 / (setup.dt * setup.dt);
+
+  active_seg_.clear();
+  for (std::size_t s = 0; s < n_seg; ++s) {
+    const auto g = static_cast<std::size_t>(surf_.seg_group[s]);
+    bool in_pair = false;
+    for (std::size_t h = 0; h < ng; ++h) in_pair = in_pair || pair_of_[h * ng + g] >= 0;
+    if (in_pair) active_seg_.push_back(static_cast<std::int32_t>(s));
+  }
+  x_sorted_.assign(3 * n_node, 0.0);
+  tangential_.clear();
+  facet_start_.assign(n_node + 1, 0);
+  node_mass_.resize(setup.mesh->n_nodes());
+  for (std::size_t i = 0; i < node_mass_.size(); ++i) node_mass_[i] = setup.mass[3 * i];
+  facet_.assign(3 * kMaxFacets * n_node, 0.0);
+  n_facets_.assign(n_node, 0);
+  node_seg_start_.assign(n_node + 1, 0);
+  for (auto e : surf_.seg_surface_node) ++node_seg_start_[static_cast<std::size_t>(e) + 1];
+  for (std::size_t e = 0; e < n_node; ++e) node_seg_start_[e + 1] += node_seg_start_[e];
+  node_seg_.resize(surf_.seg_surface_node.size());
+  {
+    std::vector<std::int32_t> fill(node_seg_start_.begin(), node_seg_start_.end() - 1);
+    for (std::size_t q = 0; q < surf_.seg_surface_node.size(); ++q)  // segments in increasing order
+      node_seg_[static_cast<std::size_t>(
+          fill[static_cast<std::size_t>(surf_.seg_surface_node[q])]++)] =
+          static_cast<std::int32_t>(q / 4);
+  }
+  cand_start_.assign(n_node + 1, 0);
+  cand_seg_.clear();
+  const std::size_t n_blocks = (n_seg + kFrameLanes - 1) / kFrameLanes;
+  frame_stamp_.assign(n_blocks, -1);
+  frame_.resize(n_blocks * kFrameLanes);
+  box_lo_.resize(3 * active_seg_.size());
+  box_hi_.resize(3 * active_seg_.size());
+  pair_force_.assign(cfg_.pairs.size(), V3{});
+  dissipation_ = 0;
+  stats_ = {};
+  sort_segments(setup.x0);
+}
+
+void PenaltyContact::compute_frames(const double* x, std::size_t blk) {
+  const std::size_t n_seg = surf_.n_segments(), s0 = blk * kFrameLanes;
+  const std::int32_t* sn = surf_.seg_nodes.data();
+  alignas(64) double p[4][3][kFrameLanes];
+  alignas(64) double depth[kFrameLanes];
+  for (int l = 0; l < kFrameLanes; ++l) {
+    const std::size_t s =
+        std::min(s0 + static_cast<std::size_t>(l), n_seg - 1);  // pad with the last
+    for (int a = 0; a < 4; ++a) {
+      const double* q = x + 3 * static_cast<std::size_t>(sn[4 * s + static_cast<std::size_t>(a)]);
+      p[a][0][l] = q[0], p[a][1][l] = q[1], p[a][2][l] = q[2];
+    }
+    depth[l] = depth_[s];
+  }
+  SegmentFrameBlock fb;
+  segment_frames(p, depth, fb);
+  // Lanes to records: the node loop reads a frame through a candidate index, 2 cache lines each.
+  const std::size_t n_lanes = std::min<std::size_t>(kFrameLanes, n_seg - s0);
+  for (std::size_t l = 0; l < n_lanes; ++l) {
+    SegmentFrame& f = frame_[s0 + l];
+    for (int k = 0; k < 3; ++k)
+      f.c[k] = fb.c[k][l], f.n[k] = fb.n[k][l], f.e1[k] = fb.e1[k][l], f.e2[k] = fb.e2[k][l];
+    f.hn = fb.hn[l], f.he1 = fb.he1[l], f.he2 = fb.he2[l], f.depth = fb.depth[l];
+  }
+}
+
+void PenaltyContact::sort_segments(const double* x) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t ng = n_groups_, n_node = surf_.n_nodes(), n_act = active_seg_.size();
+  const double margin = margin_;
+  // Frames of all segments, grown boxes of the active ones.
+  for (std::size_t blk = 0; blk < frame_stamp_.size(); ++blk) {
+    compute_frames(x, blk);
+    frame_stamp_[blk] = stats_.n_cycles;
+  }
+  for (std::size_t a = 0; a < n_act; ++a) {
+    const auto s = static_cast<std::size_t>(active_seg_[a]);
+    double p[4][3];
+    gather_segment(x, &surf_.seg_nodes[4 * s], p);
+    for (int k = 0; k < 3; ++k) {
+      const double lo = std::min({p[0][k], p[1][k], p[2][k], p[3][k]});
+      const double hi = std::max({p[0][k], p[1][k], p[2][k], p[3][k]});
+      box_lo_[3 * a + k] = lo - margin;
+      box_hi_[3 * a + k] = hi + margin;
+    }
+  }
+  grid_.build(n_act, box_lo_.data(), box_hi_.data());
+
+  // Facets of every surface node: its adjacent segment normals, clustered (in segment order, so
+  // the facet numbering, and with it the friction state, is stable from one sort to the next).
+  facet_start_old_.swap(facet_start_);
+  tangential_old_.swap(tangential_);
+  facet_start_.resize(n_node + 1);
+  facet_start_[0] = 0;
+  for (std::size_t e = 0; e < n_node; ++e) {
+    double sum[kMaxFacets][3] = {};
+    double unit[kMaxFacets][3] = {};
+    int nf = 0;
+    for (std::int32_t r = node_seg_start_[e]; r < node_seg_start_[e + 1]; ++r) {
+      const auto q = static_cast<std::size_t>(node_seg_[static_cast<std::size_t>(r)]);
+      const double* n = frame_[q].n;
+      int best = -1;
+      double best_dot = -2;
+      for (int j = 0; j < nf; ++j) {
+        const double d = unit[j][0] * n[0] + unit[j][1] * n[1] + unit[j][2] * n[2];
+        if (d > best_dot) best_dot = d, best = j;
+      }
+      if (best < 0 || (best_dot < kSameFacet && nf < kMaxFacets)) best = nf++;
+      double len = 0;
+      for (int k = 0; k < 3; ++k) sum[best][k] += n[k], len += sum[best][k] * sum[best][k];
+      len = len > 0 ? 1.0 / std::sqrt(len) : 0.0;
+      for (int k = 0; k < 3; ++k) unit[best][k] = sum[best][k] * len;
+    }
+    n_facets_[e] = static_cast<std::uint8_t>(nf);
+    facet_start_[e + 1] = facet_start_[e] + nf;
+    for (int j = 0; j < kMaxFacets; ++j)
+      for (int k = 0; k < 3; ++k)
+        facet_[(kMaxFacets * e + static_cast<std::size_t>(j)) * 3 + static_cast<std::size_t>(k)] =
+            unit[j][k];
+  }
+
+  // Friction state carried over facet by facet.
+  tangential_.assign(3 * static_cast<std::size_t>(facet_start_[n_node]), 0.0);
+  for (std::size_t e = 0; e < n_node; ++e) {
+    const std::int32_t n_keep = std::min(facet_start_old_[e + 1] - facet_start_old_[e],
+                                         facet_start_[e + 1] - facet_start_[e]);
+    for (std::int32_t k = 0; k < 3 * n_keep; ++k)
+      tangential_[3 * static_cast<std::size_t>(facet_start_[e]) + static_cast<std::size_t>(k)] =
+          tangential_old_[3 * static_cast<std::size_t>(facet_start_old_[e]) +
+                          static_cast<std::size_t>(k)];
+  }
+
+  // Candidates of every surface node.
+  cand_seg_.clear();
+  cand_facet_.clear();
+  const std::int32_t* items = grid_.items();
+  for (std::size_t e = 0; e < n_node; ++e) {
+    cand_start_[e] = static_cast<std::int32_t>(cand_seg_.size());
+    const auto i = static_cast<std::size_t>(surf_.node[e]);
+    const double* p = x + 3 * i;
+    for (int k = 0; k < 3; ++k) x_sorted_[3 * e + k] = p[k];
+    const int nf = n_facets_[e];
+    const double* fn = &facet_[3 * kMaxFacets * e];
+    const std::size_t row = static_cast<std::size_t>(surf_.node_group[e]) * ng;
+    std::int32_t b = 0, end = 0;
+    if (!grid_.cell_of(p, b, end)) continue;
+    for (std::int32_t it = b; it < end; ++it) {
+      const auto a = static_cast<std::size_t>(items[it]);
+      if (p[0] < box_lo_[3 * a] || p[0] > box_hi_[3 * a] || p[1] < box_lo_[3 * a + 1] ||
+          p[1] > box_hi_[3 * a + 1] || p[2] < box_lo_[3 * a + 2] || p[2] > box_hi_[3 * a + 2])
+        continue;
+      const auto s = static_cast<std::size_t>(active_seg_[a]);
+      if (pair_of_[row + static_cast<std::size_t>(surf_.seg_group[s])] < 0) continue;
+      const SegmentFrame& f = frame_[s];
+      const double* sn = f.n;
+      int facet = -1;
+      double most_opposed = kOpposedNormals;
+      for (int j = 0; j < nf; ++j) {
+        const double d = fn[3 * j] * sn[0] + fn[3 * j + 1] * sn[1] + fn[3 * j + 2] * sn[2];
+        if (d < most_opposed) most_opposed = d, facet = j;
+      }
+      if (facet < 0) continue;  // faces none of the node's facets
+      const double g = (p[0] - f.c[0]) * sn[0] + (p[1] - f.c[1]) * sn[1] + (p[2] - f.c[2]) * sn[2];
+      if (g < -(f.depth + margin))
+        continue;  // behind the segment: out of reach until the next sort
+      const std::int32_t* en = &surf_.seg_elem_nodes[8 * s];
+      bool own = false;
+      for (int k = 0; k < 8; ++k) own = own || en[k] == static_cast<std::int32_t>(i);
+      if (own) continue;  // a face of an element holding the node
+      cand_seg_.push_back(static_cast<std::int32_t>(s));
+      cand_facet_.push_back(static_cast<std::uint8_t>(facet));
+    }
+  }
+  cand_start_[n_node] = static_cast<std::int32_t>(cand_seg_.size());
+  ++stats_.n_sorts;
+  stats_.n_candidates = static_cast<std::int64_t>(cand_seg_.size());
+  stats_.sort_seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void PenaltyContact::add_forces(const double* x, const double* v, const double*, double dt,
+                                double* f) {
+  const std::size_t n_node = surf_.n_nodes(), ng = n_groups_;
+  ++stats_.n_cycles;
+  using Clock = std::chrono::steady_clock;
+  auto seconds = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double>(b - a).count();
+  };
+  const auto t0 = Clock::now();
+
+  // 1. Broad phase when a node may have come within reach of a segment it does not know.
+  {
+    double d2 = 0;
+    const std::int32_t* node = surf_.node.data();
+    const double* xs = x_sorted_.data();
+    for (std::size_t e = 0; e < n_node; ++e) {
+      const double* p = x + 3 * static_cast<std::size_t>(node[e]);
+      const double dx = p[0] - xs[3 * e], dy = p[1] - xs[3 * e + 1], dz = p[2] - xs[3 * e + 2];
+      d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
+    }
+    const double reach = 0.5 * (margin_ - cfg_.thickness);
+    stats_.check_seconds += seconds(t0, Clock::now());
+    if (d2 > reach * reach) sort_segments(x);
+  }
+  const auto t1 = Clock::now();
+
+  // 2. Narrow phase: each node's contact per facet (segment frames are made on first use),
+  // gathered into batches whose forces the branch-free kernel computes (contact_forces), then
+  // scattered.
+  for (auto& F : pair_force_) F = {};
+  const double thick = cfg_.thickness, lim = 1.0 + 2.0 * cfg_.edge_tolerance;
+  const double kscale = cfg_.penalty_scale * inv_dt0_sq_;
+  const double damp = 2.0 * cfg_.damping * std::sqrt(kscale);  // 2 zeta sqrt(k m_eff) / m_eff
+  const std::int32_t* node = surf_.node.data();
+  const std::int32_t* group = surf_.node_group.data();
+  const std::uint8_t* n_facets = n_facets_.data();
+  const std::int32_t* facet_start = facet_start_.data();
+  const double* m_node = node_mass_.data();
+  const std::int32_t* start = cand_start_.data();
+  const std::int32_t* cand = cand_seg_.data();
+  const std::uint8_t* cand_facet = cand_facet_.data();
+  const std::int32_t* sn = surf_.seg_nodes.data();
+  const std::int32_t* sg = surf_.seg_group.data();
+  const SegmentFrame* fr = frame_.data();
+  std::int64_t* stamp = frame_stamp_.data();
+  const std::int64_t cycle = stats_.n_cycles;
+  const double* mu_of = mu_of_.data();
+  double* tang = tangential_.data();
+  ContactBatch& B = batch_;
+  B.n = 0;
+  std::int64_t n_active = 0;
+  double max_pen = 0, dissipated = 0;
+  std::int32_t max_pen_node = -1;
+  auto flush = [&] {
+    dissipated += contact_forces(B, kscale, damp, dt);
+    for (int l = 0; l < B.n; ++l) {
+      const double Fx = B.fx[l], Fy = B.fy[l], Fz = B.fz[l];
+      const auto i = 3 * static_cast<std::size_t>(B.slave[l]);
+      f[i] += Fx, f[i + 1] += Fy, f[i + 2] += Fz;
+      const std::int32_t* corner = sn + 4 * static_cast<std::size_t>(B.seg[l]);
+      for (int a = 0; a < 4; ++a) {
+        const auto q = 3 * static_cast<std::size_t>(corner[a]);
+        f[q] -= B.N[a][l] * Fx, f[q + 1] -= B.N[a][l] * Fy, f[q + 2] -= B.N[a][l] * Fz;
+      }
+      double* ft = tang + 3 * static_cast<std::size_t>(B.state[l]);
+      ft[0] = B.tx[l], ft[1] = B.ty[l], ft[2] = B.tz[l];
+      const auto cell = static_cast<std::size_t>(B.cell[l]);
+      const double sgn = sign_of_[cell];
+      V3& R = pair_force_[static_cast<std::size_t>(pair_of_[cell])];
+      R.x += sgn * Fx, R.y += sgn * Fy, R.z += sgn * Fz;
+    }
+    B.n = 0;
+  };
+  for (std::size_t e = 0; e < n_node; ++e) {
+    const std::int32_t b = start[e], end = start[e + 1];
+    const int nf = n_facets[e];
+    double* ft_node = tang + 3 * static_cast<std::size_t>(facet_start[e]);
+    if (b == end) {
+      for (int j = 0; j < 3 * nf; ++j) ft_node[j] = 0;
+      continue;
+    }
+    const auto i = static_cast<std::size_t>(node[e]);
+    const double px = x[3 * i], py = x[3 * i + 1], pz = x[3 * i + 2];
+    std::int32_t best[kMaxFacets] = {-1, -1, -1};
+    double best_gap[kMaxFacets], bxi[kMaxFacets] = {}, beta[kMaxFacets] = {};
+    for (double& g : best_gap) g = -std::numeric_limits<double>::max();
+    for (std::int32_t c = b; c < end; ++c) {
+      const std::int32_t s = cand[c];
+      const int j = cand_facet[c];
+      // Frames are made on first use in a cycle, a block at a time, while the node loop is
+      // nearby: they are read from cache right after.
+      const auto blk = static_cast<std::size_t>(s) / kFrameLanes;
+      if (stamp[blk] != cycle) compute_frames(x, blk), stamp[blk] = cycle;
+      const SegmentFrame& F = fr[s];
+      const SegmentProjection pr = project_on_segment(F, px, py, pz);
+      // Branch-free test: candidates pass or fail unpredictably.
+      const bool hit = (std::abs(pr.xi) <= lim) & (std::abs(pr.eta) <= lim) & (pr.gap < thick) &
+                       (pr.gap > -F.depth) & (pr.gap > best_gap[j]);
+      best[j] = hit ? s : best[j];
+      best_gap[j] = hit ? pr.gap : best_gap[j];
+      bxi[j] = hit ? pr.xi : bxi[j];
+      beta[j] = hit ? pr.eta : beta[j];
+    }
+    const double m_s = m_node[i];
+    const double vsx = v[3 * i], vsy = v[3 * i + 1], vsz = v[3 * i + 2];
+    const std::size_t row = static_cast<std::size_t>(group[e]) * ng;
+    for (int j = 0; j < nf; ++j) {
+      double* ft = ft_node + 3 * j;
+      if (best[j] < 0) {
+        ft[0] = ft[1] = ft[2] = 0;
+        continue;
+      }
+      ++n_active;
+      const auto s = static_cast<std::size_t>(best[j]);
+      const SegmentFrame& F = fr[s];
+      const std::int32_t* corner = sn + 4 * s;
+      const int l = B.n++;
+      double N[4];
+      segment_shape(bxi[j], beta[j], N);
+      double m_m = 0, vmx = 0, vmy = 0, vmz = 0;
+      for (int a = 0; a < 4; ++a) {
+        const auto q = 3 * static_cast<std::size_t>(corner[a]);
+        m_m += N[a] * m_node[corner[a]];
+        vmx += N[a] * v[q], vmy += N[a] * v[q + 1], vmz += N[a] * v[q + 2];
+        B.N[a][l] = N[a];
+      }
+      const double pen = thick - best_gap[j];
+      if (pen > max_pen) max_pen = pen, max_pen_node = static_cast<std::int32_t>(i);
+      const std::size_t cell = row + static_cast<std::size_t>(sg[s]);
+      B.pen[l] = pen;
+      B.nx[l] = F.n[0], B.ny[l] = F.n[1], B.nz[l] = F.n[2];
+      B.m_s[l] = m_s, B.m_m[l] = m_m;
+      B.rx[l] = vsx - vmx, B.ry[l] = vsy - vmy, B.rz[l] = vsz - vmz;
+      B.mu[l] = mu_of[cell];
+      B.tx[l] = ft[0], B.ty[l] = ft[1], B.tz[l] = ft[2];
+      B.slave[l] = static_cast<std::int32_t>(i);
+      B.seg[l] = static_cast<std::int32_t>(s);
+      B.state[l] = facet_start[e] + j;
+      B.cell[l] = static_cast<std::int32_t>(cell);
+      if (B.n == kContactBatch) flush();
+    }
+  }
+  flush();
+  dissipation_ += dissipated;
+  stats_.n_active = n_active;
+  stats_.max_penetration = max_pen;
+  stats_.max_penetration_node = max_pen_node;
+  stats_.narrow_seconds += seconds(t1, Clock::now());
+}
+
+std::vector<ContactResultant> PenaltyContact::resultants() const {
+  std::vector<ContactResultant> out;
+  out.reserve(cfg_.pairs.size());
+  for (std::size_t p = 0; p < cfg_.pairs.size(); ++p) {
+    const auto& a = cfg_.groups[static_cast<std::size_t>(cfg_.pairs[p].first)].name;
+    const auto& b = cfg_.groups[static_cast<std::size_t>(cfg_.pairs[p].second)].name;
+    out.push_back({a + "__" + b, pair_force_[p]});
+  }
+  return out;
+}
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,117 @@
+#pragma once
+// Node-to-segment penalty contact between deformable hexahedral surfaces, with self-contact and
+// regularised Coulomb friction (an elastic tangential spring capped at mu times the normal force,
+// as for the rigid tools).
+//
+// Each cycle:
+//  1. Broad phase, only when needed: the largest nodal displacement since the last bucket sort
+//     is checked; when 2 d_max > search_margin - thickness the segments (boxes grown by the
+//     margin) are sorted into a uniform grid and each surface node gets its candidate segments
+//     (CSR): pair active, node not far behind the segment, segment not a face of an element
+//     holding the node, and the segment facing one of the node's facets. A node's facets are
+//     the directions of its own surface around it (adjacent segment normals clustered within
+//     45 deg): one on a flat or gently curved surface, two on an edge, three at a corner. A
+//     candidate faces facet j when n_facet_j . n_segment < -0.5 (opposed within 60 deg).
+//  2. A frame per candidate segment (centre, normal, dual tangents; SegmentFrame), made on its
+//     first use in the cycle, kFrameLanes segments at a time in SIMD lanes (SegmentFrameBlock).
+//  3. Narrow phase per surface node and facet: projection on each candidate; the facet's
+//     contact is the segment the node projects into (with edge_tolerance) with the largest gap
+//     below `thickness` and above -depth. One contact per facet: a node on the edge of one tow,
+//     pinched between the next tow's side and the ply above, is pushed by both; a node on a flat
+//     surface over a seam between two segments is pushed once.
+//  4. Forces of the active contacts in batches (contact_forces, a branch-free SIMD kernel):
+//     normal k (thickness - gap) plus damping that never pulls, friction from the relative
+//     tangential velocity with an elastic spring per node facet; the force goes on the node and,
+//     weighted by the shape functions, on the segment corners (they sum to zero: momentum is
+//     conserved). Penalty energy is conservative (k fixed from dt0); what friction and damping
+//     take is reported by friction_dissipation().
+// Cost is linear in the number of surface nodes; nothing is allocated per cycle (the sort reuses
+// its arrays). Masses are read once in initialise() (they do not change after assembly), so the
+// `mass` argument of add_forces is not used.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fem/contact/bucket_grid.hpp"
+#include "fem/contact/contact_config.hpp"
+#include "fem/contact/contact_force_kernel.hpp"
+#include "fem/contact/contact_surface.hpp"
+#include "fem/contact/segment_frame.hpp"
+#include "fem/contact_interface.hpp"
+
+namespace ncfsim::fem {
+
+/// Counters of a penalty contact (diagnostics, benchmarks).
+struct PenaltyContactStats {
+  std::int64_t n_cycles = 0;
+  std::int64_t n_sorts = 0;                // bucket sorts (broad-phase rebuilds), incl. the first
+  std::int64_t n_candidates = 0;           // node-segment candidates after the last sort
+  std::int64_t n_active = 0;               // contacts in the last cycle
+  double max_penetration = 0;              // largest (thickness - gap) in the last cycle, m
+  std::int32_t max_penetration_node = -1;  // mesh node where it occurs
+  double sort_seconds = 0;                 // time in bucket sorts (broad phase)
+  double check_seconds = 0;                // time in the displacement checks
+  double narrow_seconds = 0;  // time in the narrow phase (incl. segment frames) and forces
+};
+
+class PenaltyContact final : public ContactAlgorithm {
+ public:
+  static constexpr int kMaxFacets = 3;
+
+  /// Checks the configuration's ranges (InputError); the mesh is checked in initialise().
+  explicit PenaltyContact(PenaltyContactConfig config);
+
+  const std::string& name() const override { return cfg_.name; }
+  void initialise(const ContactSetup& setup) override;
+  void add_forces(const double* x, const double* v, const double* mass, double dt,
+                  double* f_contact) override;
+  double friction_dissipation() const override { return dissipation_; }
+  std::vector<ContactResultant> resultants() const override;
+  std::int64_t active_contacts() const override { return stats_.n_active; }
+
+  const PenaltyContactConfig& config() const { return cfg_; }
+  const ContactSurface& surface() const { return surf_; }
+  const PenaltyContactStats& stats() const { return stats_; }
+  double search_margin() const { return margin_; }
+  std::size_t n_contact_nodes() const { return surf_.n_nodes(); }
+
+ private:
+  void sort_segments(const double* x);                      // broad phase at positions x
+  void compute_frames(const double* x, std::size_t block);  // frames of one block at x
+
+  PenaltyContactConfig cfg_;
+  ContactSurface surf_;
+  std::size_t n_groups_ = 0;
+  std::vector<std::int32_t> pair_of_;  // [n_groups][n_groups] pair index or -1
+  std::vector<double> mu_of_;          // [n_groups][n_groups] friction coefficient
+  std::vector<double> sign_of_;        // [n_groups][n_groups] +1: slave group is the pair's first
+  double margin_ = 0;                  // search margin, m
+  double inv_dt0_sq_ = 0;              // 1 / dt0^2
+  std::vector<double> depth_;          // [n_seg] max_penetration * element thickness
+
+  // State and work arrays, sized in initialise(), reused every cycle.
+  std::vector<double> x_sorted_;           // [n_snode][3] positions at the last sort
+  std::vector<double> tangential_;         // [n_facet][3] elastic friction force per node facet, N
+  std::vector<std::int32_t> facet_start_;  // [n_snode + 1] first facet of each surface node
+  std::vector<double> tangential_old_;     // the two above before the last sort (carried over)
+  std::vector<std::int32_t> facet_start_old_;
+  std::vector<double> node_mass_;          // [n_nodes] lumped nodal masses (fixed after set-up), kg
+  std::vector<std::int32_t> cand_start_;   // [n_snode + 1] CSR into cand_seg_
+  std::vector<std::int32_t> cand_seg_;     // candidate segments, node by node
+  std::vector<std::uint8_t> cand_facet_;   // facet of the node each candidate faces
+  std::vector<std::int64_t> frame_stamp_;  // [n_blocks] cycle the block's frames were made in
+  std::vector<SegmentFrame> frame_;        // [n_blocks * kFrameLanes] (valid in used blocks)
+  std::vector<double> box_lo_, box_hi_;    // [n_seg][3] grown segment boxes at the sort
+  std::vector<double> facet_;              // [n_snode][kMaxFacets][3] facet normals at the sort
+  std::vector<std::uint8_t> n_facets_;     // [n_snode]
+  std::vector<std::int32_t> node_seg_start_, node_seg_;  // segments around each surface node (CSR)
+  std::vector<std::int32_t> active_seg_;  // [n_seg] index into segs of the grid (active groups)
+  BucketGrid grid_;
+
+  ContactBatch batch_;          // active contacts on their way through the force kernel
+  std::vector<V3> pair_force_;  // [n_pairs] force on the pair's first group
+  double dissipation_ = 0;
+  PenaltyContactStats stats_;
+};
+
+}  // namespace ncfsim::fem

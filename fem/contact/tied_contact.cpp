@@ -1,0 +1,190 @@
+#include "fem/contact/tied_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "fem/contact/bucket_grid.hpp"
+#include "fem/contact/contact_surface.hpp"
+#include "fem/contact/segment_frame.hpp"
+#include "fem/errors.hpp"
+
+namespace ncfsim::fem {
+
+namespace {
+
+// Orthonormal frame (t1 along a1, t2, n) of a segment with corners p, and the point at (xi, eta)
+// with its shape functions N.
+struct TieFrame {
+  double t1[3], t2[3], n[3], x[3], N[4];
+};
+
+inline void tie_frame(const double (&p)[4][3], double xi, double eta, TieFrame& f) {
+  double a1[3], a2[3];
+  segment_shape(xi, eta, f.N);
+  for (int k = 0; k < 3; ++k) {
+    a1[k] = 0.25 * (-p[0][k] + p[1][k] + p[2][k] - p[3][k]);
+    a2[k] = 0.25 * (-p[0][k] - p[1][k] + p[2][k] + p[3][k]);
+    f.x[k] = f.N[0] * p[0][k] + f.N[1] * p[1][k] + f.N[2] * p[2][k] + f.N[3] * p[3][k];
+  }
+  double n[3] = {a1[1] * a2[2] - a1[2] * a2[1], a1[2] * a2[0] - a1[0] * a2[2],
+                 a1[0] * a2[1] - a1[1] * a2[0]};
+  const double ln = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  const double la = std::sqrt(a1[0] * a1[0] + a1[1] * a1[1] + a1[2] * a1[2]);
+  const double in = ln > 0 ? 1.0 / ln : 0.0, ia = la > 0 ? 1.0 / la : 0.0;
+  for (int k = 0; k < 3; ++k) f.n[k] = n[k] * in, f.t1[k] = a1[k] * ia;
+  f.t2[0] = f.n[1] * f.t1[2] - f.n[2] * f.t1[1];
+  f.t2[1] = f.n[2] * f.t1[0] - f.n[0] * f.t1[2];
+  f.t2[2] = f.n[0] * f.t1[1] - f.n[1] * f.t1[0];
+}
+
+}  // namespace
+
+TiedContact::TiedContact(TiedContactConfig config) : cfg_(std::move(config)) { validate(cfg_); }
+
+void TiedContact::initialise(const ContactSetup& setup) {
+  const std::string prefix = "contact." + cfg_.name;
+  if (!setup.mesh || !setup.x0 || !setup.mass || !(setup.dt > 0))
+    throw InputError(cfg_.source_file, prefix, "contact set up without mesh, masses or step");
+  ContactGroup slave = cfg_.slave, master = cfg_.master;
+  if (slave.name.empty()) slave.name = "slave";
+  if (master.name.empty()) master.name = "master";
+  const ContactSurface surf =
+      extract_contact_surface(*setup.mesh, {slave, master}, setup.x0, cfg_.source_file, prefix);
+  const double* x0 = setup.x0;
+  const double* mass = setup.mass;
+  std::vector<std::int32_t> master_seg;
+  double t_min = std::numeric_limits<double>::max();
+  for (std::size_t s = 0; s < surf.n_segments(); ++s)
+    if (surf.seg_group[s] == 1) {
+      master_seg.push_back(static_cast<std::int32_t>(s));
+      t_min = std::min(t_min, surf.seg_elem_thickness[s]);
+    }
+  search_distance_ = cfg_.search_distance > 0 ? cfg_.search_distance : 0.1 * t_min;
+  const double r = search_distance_;
+
+  // Master segments in a grid, boxes grown by the search distance.
+  const std::size_t n_m = master_seg.size();
+  std::vector<double> lo(3 * n_m), hi(3 * n_m);
+  for (std::size_t a = 0; a < n_m; ++a) {
+    double p[4][3];
+    gather_segment(x0, &surf.seg_nodes[4 * static_cast<std::size_t>(master_seg[a])], p);
+    for (int k = 0; k < 3; ++k) {
+      lo[3 * a + k] = std::min({p[0][k], p[1][k], p[2][k], p[3][k]}) - r;
+      hi[3 * a + k] = std::max({p[0][k], p[1][k], p[2][k], p[3][k]}) + r;
+    }
+  }
+  BucketGrid grid;
+  grid.build(n_m, lo.data(), hi.data());
+
+  const double inv_dt0_sq = 1.0 / (setup.dt * setup.dt);
+  for (std::size_t e = 0; e < surf.n_nodes(); ++e) {
+    if (surf.node_group[e] != 0) continue;
+    const std::int32_t node = surf.node[e];
+    const double* p = x0 + 3 * static_cast<std::size_t>(node);
+    std::int32_t b = 0, end = 0;
+    if (!grid.cell_of(p, b, end)) continue;
+    double best_d2 = r * r;
+    std::int32_t best = -1;
+    double bxi = 0, beta = 0;
+    for (std::int32_t it = b; it < end; ++it) {
+      const auto a = static_cast<std::size_t>(grid.items()[it]);
+      if (p[0] < lo[3 * a] || p[0] > hi[3 * a] || p[1] < lo[3 * a + 1] || p[1] > hi[3 * a + 1] ||
+          p[2] < lo[3 * a + 2] || p[2] > hi[3 * a + 2])
+        continue;
+      const auto s = static_cast<std::size_t>(master_seg[a]);
+      const std::int32_t* cn = &surf.seg_nodes[4 * s];
+      if (std::find(cn, cn + 4, node) != cn + 4) continue;  // shares the node: already joined
+      double q[4][3];
+      gather_segment(x0, cn, q);
+      SegmentFrame f;
+      segment_frame(q, 0, f);
+      const SegmentProjection pr = project_on_segment(f, p[0], p[1], p[2]);
+      const double xi = std::clamp(pr.xi, -1.0, 1.0), eta = std::clamp(pr.eta, -1.0, 1.0);
+      TieFrame tf;
+      tie_frame(q, xi, eta, tf);
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) d2 += (p[k] - tf.x[k]) * (p[k] - tf.x[k]);
+      if (d2 <= best_d2) best_d2 = d2, best = static_cast<std::int32_t>(s), bxi = xi, beta = eta;
+    }
+    if (best < 0) continue;
+    const auto s = static_cast<std::size_t>(best);
+    double q[4][3];
+    gather_segment(x0, &surf.seg_nodes[4 * s], q);
+    TieFrame tf;
+    tie_frame(q, bxi, beta, tf);
+    double off[3] = {0, 0, 0}, m_m = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = p[k] - tf.x[k];
+      off[0] += d * tf.t1[k], off[1] += d * tf.t2[k], off[2] += d * tf.n[k];
+    }
+    for (int a = 0; a < 4; ++a)
+      m_m += tf.N[a] * mass[3 * static_cast<std::size_t>(surf.seg_nodes[4 * s + a])];
+    const double m_s = mass[3 * static_cast<std::size_t>(node)];
+    node_.push_back(node);
+    for (int a = 0; a < 4; ++a) corner_.push_back(surf.seg_nodes[4 * s + a]);
+    xi_.push_back(bxi);
+    eta_.push_back(beta);
+    offset_.insert(offset_.end(), off, off + 3);
+    stiffness_.push_back(cfg_.penalty_scale * m_s * m_m / (m_s + m_m) * inv_dt0_sq);
+    normal_cap_.push_back(cfg_.normal_strength * surf.node_area[e]);
+    shear_cap_.push_back(cfg_.shear_strength * surf.node_area[e]);
+  }
+  if (node_.empty())
+    throw InputError(cfg_.source_file, prefix + ".search_distance",
+                     "no slave node lies within " + std::to_string(r) + " m of the master surface");
+  alive_.assign(node_.size(), 1);
+  n_alive_ = static_cast<std::int64_t>(node_.size());
+  dissipation_ = 0;
+  force_ = {};
+}
+
+void TiedContact::add_forces(const double* x, const double*, const double*, double, double* f) {
+  const std::size_t n = node_.size();
+  double Rx = 0, Ry = 0, Rz = 0, released = 0;
+  std::int64_t failed = 0;
+  for (std::size_t t = 0; t < n; ++t) {
+    if (!alive_[t]) continue;
+    double q[4][3];
+    gather_segment(x, &corner_[4 * t], q);
+    TieFrame tf;
+    tie_frame(q, xi_[t], eta_[t], tf);
+    const double* o = &offset_[3 * t];
+    const auto i = 3 * static_cast<std::size_t>(node_[t]);
+    double d[3];
+    for (int k = 0; k < 3; ++k)
+      d[k] = x[i + k] - (tf.x[k] + o[0] * tf.t1[k] + o[1] * tf.t2[k] + o[2] * tf.n[k]);
+    const double k = stiffness_[t];
+    const double dn = d[0] * tf.n[0] + d[1] * tf.n[1] + d[2] * tf.n[2];
+    const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    const double tension = dn > 0 ? k * dn : 0.0;
+    const double shear = k * std::sqrt(std::max(d2 - dn * dn, 0.0));
+    double crit = 0;
+    if (normal_cap_[t] > 0) crit += (tension / normal_cap_[t]) * (tension / normal_cap_[t]);
+    if (shear_cap_[t] > 0) crit += (shear / shear_cap_[t]) * (shear / shear_cap_[t]);
+    if (crit >= 1) {
+      alive_[t] = 0;
+      ++failed;
+      released += 0.5 * k * d2;
+      continue;
+    }
+    const double Fx = -k * d[0], Fy = -k * d[1], Fz = -k * d[2];
+    f[i] += Fx, f[i + 1] += Fy, f[i + 2] += Fz;
+    for (int a = 0; a < 4; ++a) {
+      const auto j = 3 * static_cast<std::size_t>(corner_[4 * t + a]);
+      f[j] -= tf.N[a] * Fx, f[j + 1] -= tf.N[a] * Fy, f[j + 2] -= tf.N[a] * Fz;
+    }
+    Rx += Fx, Ry += Fy, Rz += Fz;
+  }
+  n_alive_ -= failed;
+  dissipation_ += released;
+  force_ = {Rx, Ry, Rz};
+}
+
+std::vector<ContactResultant> TiedContact::resultants() const {
+  const std::string a = cfg_.slave.name.empty() ? "slave" : cfg_.slave.name;
+  const std::string b = cfg_.master.name.empty() ? "master" : cfg_.master.name;
+  return {{a + "__" + b, force_}};
+}
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,55 @@
+#pragma once
+// Tied contact: each node of the slave surface is tied at t = 0 to the nearest point of the master
+// surface (a segment and local coordinates, plus the initial offset in the segment's own frame, so
+// the tie follows rigid rotations), held there by a penalty spring k = penalty_scale * m_s m_m /
+// (m_s + m_m) / dt0^2 in all directions. A tie fails on the quadratic criterion of
+// TiedContactConfig; a failed tie's elastic energy is counted as dissipated
+// (friction_dissipation()) and it carries no force afterwards.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fem/contact/contact_config.hpp"
+#include "fem/contact_interface.hpp"
+
+namespace ncfsim::fem {
+
+class TiedContact final : public ContactAlgorithm {
+ public:
+  /// Checks the configuration's ranges (InputError); the mesh is checked in initialise().
+  explicit TiedContact(TiedContactConfig config);
+
+  const std::string& name() const override { return cfg_.name; }
+  void initialise(const ContactSetup& setup) override;
+  void add_forces(const double* x, const double* v, const double* mass, double dt,
+                  double* f_contact) override;
+  /// Elastic energy released by failed ties, J.
+  double friction_dissipation() const override { return dissipation_; }
+  /// One resultant "slave__master": the force on the slave group.
+  std::vector<ContactResultant> resultants() const override;
+  /// Ties still holding.
+  std::int64_t active_contacts() const override { return n_alive_; }
+
+  const TiedContactConfig& config() const { return cfg_; }
+  std::size_t n_ties() const { return node_.size(); }
+  std::size_t n_failed() const { return node_.size() - static_cast<std::size_t>(n_alive_); }
+  double search_distance() const { return search_distance_; }
+
+ private:
+  TiedContactConfig cfg_;
+  double search_distance_ = 0;
+  // One entry per tie (structure of arrays).
+  std::vector<std::int32_t> node_;    // [n_tie] slave node
+  std::vector<std::int32_t> corner_;  // [n_tie][4] master segment corners
+  std::vector<double> xi_, eta_;      // [n_tie] local coordinates on the segment
+  std::vector<double> offset_;        // [n_tie][3] initial offset along (t1, t2, n) of the segment
+  std::vector<double> stiffness_;     // [n_tie] k, N/m
+  std::vector<double> normal_cap_;    // [n_tie] tensile strength * area, N (0: none)
+  std::vector<double> shear_cap_;     // [n_tie] shear strength * area, N (0: none)
+  std::vector<std::uint8_t> alive_;   // [n_tie]
+  std::int64_t n_alive_ = 0;
+  double dissipation_ = 0;
+  V3 force_;  // on the slave group, N
+};
+
+}  // namespace ncfsim::fem
