@@ -75,7 +75,9 @@ struct Model {
   std::vector<NodalLoad> loads;
   std::vector<InitialVelocity> initial_velocities;
   V3 gravity;
+  double gravity_ramp_time = 0;  // smooth ramp of gravity from 0 (settling without a jolt)
   double mass_damping = 0;  // mass-proportional damping coefficient alpha (1/s)
+  double mass_damping_end_time = 0;  // > 0: damping acts only before this time (settling)
   std::vector<RigidTool> tools;
   std::vector<std::unique_ptr<ContactAlgorithm>> contacts;  // deformable / tied contacts
   TimeControl time;

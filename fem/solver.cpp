@@ -284,7 +284,8 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   // Arrays a model does not use stay zero and are neither cleared nor read in the node loop.
   const bool has_ext = !model_.loads.empty() || model_.gravity.x != 0 || model_.gravity.y != 0 || model_.gravity.z != 0;
   const bool has_contact = !model_.tools.empty() || !model_.contacts.empty();
-  const bool has_damp = model_.mass_damping != 0;
+  const bool has_damp = model_.mass_damping != 0 &&
+                        (model_.mass_damping_end_time <= 0 || t_ < model_.mass_damping_end_time);
   std::fill(fi, fi + nd, 0.0);
   if (has_ext) std::fill(Fe.data(), Fe.data() + nd, 0.0);
   if (has_contact) std::fill(Fc.data(), Fc.data() + nd, 0.0);
@@ -321,12 +322,12 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       Fe[3 * i] += F.x, Fe[3 * i + 1] += F.y, Fe[3 * i + 2] += F.z;
     }
   }
-  const V3 g = model_.gravity;
+  const V3 g = smooth_ramp(t_, model_.gravity_ramp_time) * model_.gravity;
   if (g.x != 0 || g.y != 0 || g.z != 0)
     for (std::size_t i = 0; i < n; ++i)
       Fe[3 * i] += gravity_mass_[3 * i] * g.x, Fe[3 * i + 1] += gravity_mass_[3 * i + 1] * g.y,
       Fe[3 * i + 2] += gravity_mass_[3 * i + 2] * g.z;
-  const double alpha = model_.mass_damping;
+  const double alpha = has_damp ? model_.mass_damping : 0.0;
 
   if (dt_new < model_.time.min_step_ratio * dt_initial_) {
     std::ostringstream os;

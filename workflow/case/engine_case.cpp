@@ -530,6 +530,7 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
   }
   if (auto ld = root.table("load")) {
     ec.model.gravity = to_v3(ld->vec3_or("gravity", {0, 0, 0}));
+    ec.model.gravity_ramp_time = ld->number("gravity_ramp_time", 0.0, Range::non_negative());
     for (const auto& t : ld->tables("nodal_force")) {
       fem::NodalLoad l;
       l.name = t.string("name");
@@ -539,7 +540,10 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       ec.model.loads.push_back(std::move(l));
     }
   }
-  if (auto d = root.table("damping")) ec.model.mass_damping = d->number("mass_proportional", 0.0, Range::non_negative());
+  if (auto d = root.table("damping")) {
+    ec.model.mass_damping = d->number("mass_proportional", 0.0, Range::non_negative());
+    ec.model.mass_damping_end_time = d->number("end_time", 0.0, Range::non_negative());
+  }
   if (auto init = root.table("initial"))
     for (const auto& t : init->tables("velocity"))
       ec.model.initial_velocities.push_back({select_nodes(t, "nodes", mesh), to_v3(t.vec3("velocity"))});
@@ -577,6 +581,17 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       sp.box_min = t.vec3("box_min");
       sp.box_max = t.vec3("box_max");
       ec.shear_probes.push_back(sp);
+    }
+    for (const auto& t : o->tables("mean")) {
+      SummaryMean sm;
+      sm.name = t.string("name");
+      sm.column = t.string("column");
+      sm.from_time = t.number("from_time", Range::non_negative());
+      sm.to_time = t.number("to_time", Range::positive());
+      if (!(sm.to_time > sm.from_time)) t.fail("to_time", "must be after from_time");
+      sm.scale = t.number("scale", 1.0, {});
+      sm.per_column = t.string("per_column", "");
+      ec.means.push_back(sm);
     }
     for (const auto& t : o->tables("bending_length")) {
       BendingLengthProbe bp;

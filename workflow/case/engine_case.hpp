@@ -54,6 +54,14 @@ struct BendingLengthProbe {
   std::vector<std::int32_t> root, tip;
 };
 
+/// Mean of a history column over a time window, times a scale, into summary.json as <name>
+/// (e.g. the friction coefficient F/P of a sled over its steady sliding).
+struct SummaryMean {
+  std::string name, column;
+  double from_time = 0, to_time = 0, scale = 1;
+  std::string per_column;  // if set: scale * increment of column / increment of per_column over the window
+};
+
 struct OutputSettings {
   bool xdmf = true;           // results.h5 + results.xdmf
   bool vtu = false;           // frames/*.vtu + results.pvd
@@ -121,6 +129,7 @@ struct EngineCase {
   std::vector<ShearProbe> shear_probes;
   std::vector<SummarySamples> samples;
   std::vector<BendingLengthProbe> bending;
+  std::vector<SummaryMean> means;
 };
 
 /// Reads and checks a case (throws InputError naming file and key). `overrides` are --set items.

@@ -352,7 +352,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     if (!history) history = std::make_unique<HistoryWriter>(dir / "history.csv", hc.names);
     row.resize(hc.names.size(), std::numeric_limits<double>::quiet_NaN());  // a resultant that came later
     history->write_row(row);
-    if (!ec.samples.empty()) kept_rows.push_back(row);
+    if (!ec.samples.empty() || !ec.means.empty()) kept_rows.push_back(row);
   };
 
   // Frames.
@@ -420,6 +420,32 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
       summary[bp.name + "_beam_theory_bending_length_m"] =
           std::cbrt(bs.E1 * bs.thickness * bs.thickness * bs.thickness / 12.0 / (bs.areal_mass * g));
       summary[bp.name + "_axial_modulus_Pa"] = bs.E1;
+    }
+    for (const auto& sm : ec.means) {
+      int c = -1, cp = -1;
+      for (std::size_t k = 0; k < hc.names.size(); ++k) {
+        if (hc.names[k] == sm.column) c = static_cast<int>(k);
+        if (hc.names[k] == sm.per_column) cp = static_cast<int>(k);
+      }
+      double sum = 0;
+      std::size_t n = 0;
+      const std::vector<double>*first = nullptr, *last = nullptr;
+      for (const auto& r : kept_rows)
+        if (c >= 0 && r[0] >= sm.from_time && r[0] <= sm.to_time) {
+          sum += r[static_cast<std::size_t>(c)], ++n;
+          if (!first) first = &r;
+          last = &r;
+        }
+      double value = n ? sm.scale * sum / static_cast<double>(n) : std::nan("");
+      if (!sm.per_column.empty()) {  // ratio of increments over the window
+        value = std::nan("");
+        if (cp >= 0 && first && last && (*last)[static_cast<std::size_t>(cp)] != (*first)[static_cast<std::size_t>(cp)])
+          value = sm.scale * ((*last)[static_cast<std::size_t>(c)] - (*first)[static_cast<std::size_t>(c)]) /
+                  ((*last)[static_cast<std::size_t>(cp)] - (*first)[static_cast<std::size_t>(cp)]);
+      }
+      summary[sm.name] = std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+      if ((c < 0 || (!sm.per_column.empty() && cp < 0)) && !hc.names.empty())
+        summary[sm.name + "_error"] = "no history column '" + (c < 0 ? sm.column : sm.per_column) + "'";
     }
     for (const auto& ss : ec.samples) {
       const auto col = [&](const std::string& name) -> int {
