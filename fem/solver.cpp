@@ -398,12 +398,13 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   // energy balance of central differences exact for conservative forces.
   ext_old *= dtp, ext_new *= dt_new, damp_old *= dtp, damp_new *= dt_new, con_old *= dtp, con_new *= dt_new;
   ke *= 0.5;
+  const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
   for (std::size_t k = 0; k < constrained_.size(); ++k) {
     const std::size_t d = constrained_[k];
     const std::uint8_t code = fixed_mask_[d];
     const double vo = constrained_vo_[k], m = mm[d], vfree = vel[d];
     const double vp = code == 1 ? 0.0 : vpres[code - 2].arr()[d % 3];
-    const double r = dt_mid > 0 ? m * (vp - vfree) / dt_mid : 0.0;
+    const double r = m * (vp - vfree) * inv_dt_mid;
     rr[d] = r;
     vel[d] = vp;
     const double dv = vp - vfree;
