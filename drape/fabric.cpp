@@ -51,12 +51,14 @@ void validate(const FabricSpec& f, const std::string& file, const std::string& p
     // Penetration points must fall into the gaps of every ply: along x and y their spacing must be
     // a whole number of tow pitches projected on the axes, p / |sin a| and p / |cos a|.
     const double p = f.tow_pitch();
+    if (!(f.stitch_direction_deg >= -90 && f.stitch_direction_deg <= 90))
+      fail("stitch_direction_deg", "must be in [-90, 90] degrees");
     for (double a : f.ply_angles_deg) {
-      const double ar = a * M_PI / 180.0;
+      const double ar = (a - f.stitch_direction_deg) * M_PI / 180.0;  // tow angle to the wales
       const double sx = std::abs(std::sin(ar)), cy = std::abs(std::cos(ar));
       std::ostringstream why;
       if (sx > 1e-9 && !integer_multiple(f.penetration_spacing(), p / sx)) {
-        why << "stitch penetrations every " << f.penetration_spacing() * 1e3 << " mm along x do not fall into the gaps "
+        why << "stitch penetrations every " << f.penetration_spacing() * 1e3 << " mm along the wales do not fall into the gaps "
             << "between tows of the " << a << " deg ply (tow pitch " << p * 1e3 << " mm needs a multiple of "
             << p / sx * 1e3 << " mm): the tow is wider than the stitch geometry allows";
         fail(f.stitch_length > 0 ? "stitch_length" : "tow_width", why.str());

@@ -17,6 +17,7 @@ struct FabricSpec {
   double fibre_density = 1800.0;             // kg/m^3 (T700)
   double tow_fibre_volume_fraction = 0.6;    // (0, 0.9069]
   StitchPattern stitch = StitchPattern::Tricot;
+  double stitch_direction_deg = 0;           // wale (machine) direction to x; ply angles are to x too
   double stitch_gauge = 0;                   // m between wales (across x); 0: tow pitch * sqrt(2)
   double stitch_length = 0;                  // m between penetrations along a wale; 0: as the gauge
   // Mesh resolution of a tow.

@@ -42,9 +42,16 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   FabricModel fm;
   fm.tow_thickness = t;
   const std::array<double, 2> lo{bl.origin[0], bl.origin[1]}, hi{bl.origin[0] + Lx, bl.origin[1] + Ly};
-  // Penetration grid, centred in the blanket; its first point sets the gap lines of every ply.
+  // Penetration lattice: along the wales m (the stitch direction) every s, across them n every g,
+  // centred in the blanket; points closer to the edge than half a spacing are left out. Its
+  // reference point sets the gap lines of every ply. With the wales along x this is the centred
+  // nx x ny grid.
+  const double md = f.stitch_direction_deg * M_PI / 180.0;
+  const std::array<double, 2> mdir{std::cos(md), std::sin(md)}, ndir{-std::sin(md), std::cos(md)};
   const int nx = static_cast<int>(std::floor(Lx / s)), ny = static_cast<int>(std::floor(Ly / g));
-  const double x_first = lo[0] + 0.5 * (Lx - (nx - 1) * s), y_first = lo[1] + 0.5 * (Ly - (ny - 1) * g);
+  const double cx = lo[0] + 0.5 * Lx, cy = lo[1] + 0.5 * Ly;
+  const double x_first = cx - 0.5 * (nx - 1) * s * mdir[0] - 0.5 * (ny - 1) * g * ndir[0];
+  const double y_first = cy - 0.5 * (nx - 1) * s * mdir[1] - 0.5 * (ny - 1) * g * ndir[1];
   const double h_el = f.element_length > 0 ? f.element_length : p;
   const int nw = f.elements_across_tow, nt = f.elements_through_thickness;
 
@@ -126,48 +133,56 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
 
   if (f.stitch == StitchPattern::None) return fm;
 
-  // Stitch nodes at the penetration points, on the top and bottom faces.
+  // Stitch nodes at the penetration points, on the top and bottom faces. Lattice index (i, j),
+  // i along the wale; index ranges cover the blanket whatever the stitch direction.
   const double z_bot = bl.z0, z_top = bl.z0 + t * static_cast<double>(f.ply_angles_deg.size());
-  std::vector<std::int32_t> top(static_cast<std::size_t>(nx * ny)), bot(static_cast<std::size_t>(nx * ny));
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const double x = x_first + i * s, y = y_first + j * g;
+  const int reach_i = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / s)) + 1;
+  const int reach_j = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / g)) + 1;
+  const int i0 = -reach_i, j0 = -reach_j, ni = 2 * reach_i + nx, nj = 2 * reach_j + ny;
+  const double mx = 0.5 * (s * std::abs(mdir[0]) + g * std::abs(ndir[0])), my = 0.5 * (s * std::abs(mdir[1]) + g * std::abs(ndir[1]));
+  std::vector<std::int32_t> top(static_cast<std::size_t>(ni * nj), -1), bot(top);
+  int i_min = 1 << 30;
+  for (int jj = 0; jj < nj; ++jj)
+    for (int ii = 0; ii < ni; ++ii) {
+      const int i = ii + i0, j = jj + j0;
+      const double x = x_first + i * s * mdir[0] + j * g * ndir[0], y = y_first + i * s * mdir[1] + j * g * ndir[1];
+      if (x < lo[0] + mx - 1e-9 * Lx || x > hi[0] - mx + 1e-9 * Lx || y < lo[1] + my - 1e-9 * Ly || y > hi[1] - my + 1e-9 * Ly)
+        continue;
+      i_min = std::min(i_min, ii);
       for (auto* arr : {&top, &bot}) {
-        (*arr)[static_cast<std::size_t>(j * nx + i)] = static_cast<std::int32_t>(mesh.n_nodes());
+        (*arr)[static_cast<std::size_t>(jj * ni + ii)] = static_cast<std::int32_t>(mesh.n_nodes());
         fm.stitch_nodes.push_back(static_cast<std::int32_t>(mesh.n_nodes()));
         mesh.coords.insert(mesh.coords.end(), {x, y, arr == &top ? z_top : z_bot});
       }
+      ++fm.n_penetrations;
     }
-  fm.n_penetrations = static_cast<std::size_t>(nx * ny);
+  if (fm.n_penetrations == 0) throw InputError(file, "blanket.size", "the blanket holds no stitch penetration");
   fm.stitch_I_part = mesh.add_part(prefix + "stitch_I");
   fm.stitch_leg_part = mesh.add_part(prefix + "stitch_legs");
   const bool tricot = f.stitch == StitchPattern::Tricot;
   fm.stitch_Lambda_part = tricot ? mesh.add_part(prefix + "stitch_Lambda") : fm.stitch_I_part;
-  auto at = [&](std::vector<std::int32_t>& arr, int i, int j) { return arr[static_cast<std::size_t>(j * nx + i)]; };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i + 1 < nx; ++i) {  // pillars along each wale, top face
-      mesh.bars.push_back({at(top, i, j), at(top, i + 1, j)});
-      mesh.bar_part.push_back(fm.stitch_I_part);
-    }
-  if (tricot) {
-    // Underlaps: the yarn of wale j laps between wales j and j+1 every course (zig-zag).
-    for (int j = 0; j + 1 < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {
-        mesh.bars.push_back({at(bot, i, j + (i % 2)), at(bot, i + 1, j + ((i + 1) % 2))});
-        mesh.bar_part.push_back(fm.stitch_Lambda_part);
+  auto at = [&](const std::vector<std::int32_t>& arr, int i, int j) -> std::int32_t {
+    if (i < 0 || j < 0 || i >= ni || j >= nj) return -1;
+    return arr[static_cast<std::size_t>(j * ni + i)];
+  };
+  auto bar = [&](std::int32_t a, std::int32_t b, int part) {
+    if (a < 0 || b < 0) return;
+    mesh.bars.push_back({a, b});
+    mesh.bar_part.push_back(part);
+  };
+  for (int j = 0; j < nj; ++j)
+    for (int i = 0; i + 1 < ni; ++i) bar(at(top, i, j), at(top, i + 1, j), fm.stitch_I_part);  // pillars, top face
+  for (int j = 0; j < nj; ++j)
+    for (int i = 0; i + 1 < ni; ++i) {
+      if (tricot) {  // underlaps: the yarn of wale j laps between wales j and j+1 every course
+        const int p0 = (i - i_min) & 1, p1 = (i + 1 - i_min) & 1;
+        bar(at(bot, i, j + p0), at(bot, i + 1, j + p1), fm.stitch_Lambda_part);
+      } else {
+        bar(at(bot, i, j), at(bot, i + 1, j), fm.stitch_I_part);
       }
-  } else {
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {
-        mesh.bars.push_back({at(bot, i, j), at(bot, i + 1, j)});
-        mesh.bar_part.push_back(fm.stitch_I_part);
-      }
-  }
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      mesh.bars.push_back({at(top, i, j), at(bot, i, j)});
-      mesh.bar_part.push_back(fm.stitch_leg_part);
     }
+  for (int j = 0; j < nj; ++j)
+    for (int i = 0; i < ni; ++i) bar(at(top, i, j), at(bot, i, j), fm.stitch_leg_part);
 
   // Connections: each stitch node to the nearest node of every tow within reach on its face.
   const double reach = 0.5 * f.tow_gap + std::max(w / nw, h_el) * 0.75;

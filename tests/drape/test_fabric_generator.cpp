@@ -153,3 +153,30 @@ TEST(FabricGenerator, BadFabricsNameTheKey) {
   f.ply_angles_deg = {};
   expect_key(f, "ply_angles_deg");
 }
+
+// The same NCF seen in a frame turned by 45 deg (tows along x and y, wales at 45 deg), as a
+// picture-frame unit cell is mounted: penetrations still fall into the gaps of both plies and
+// every stitch bar is joined at both ends.
+TEST(FabricGenerator, RotatedStitchLattice) {
+  drape::FabricSpec f;
+  f.ply_angles_deg = {0.0, 90.0};
+  f.stitch_direction_deg = 45.0;
+  EXPECT_NO_THROW(drape::validate(f, "", "fabric"));
+  const auto b = build(f, 0.03, 0.03);
+  EXPECT_GT(b.fm.n_penetrations, 20u);
+  std::set<std::int32_t> connected;
+  for (const auto& c : b.fm.connections) connected.insert(c.stitch_node);
+  for (const auto& bar : b.mesh.bars)
+    for (auto nd : bar) EXPECT_TRUE(connected.count(nd)) << "stitch node " << nd << " is joined to no tow";
+  // Each penetration point lies in a gap of the 0 deg ply (y between tows) and of the 90 deg ply.
+  const double p = f.tow_pitch();
+  for (auto nd : b.fm.stitch_nodes) {
+    for (int axis = 0; axis < 2; ++axis) {
+      const double v = b.mesh.coords[3 * nd + (axis == 0 ? 1 : 0)];
+      // distance to the nearest gap line (gap lines are p apart)
+      const double first = b.mesh.coords[3 * b.fm.stitch_nodes.front() + (axis == 0 ? 1 : 0)];
+      const double r = std::remainder(v - first, p);
+      EXPECT_LT(std::abs(r), 1e-9) << "penetration off the gap line";
+    }
+  }
+}

@@ -390,6 +390,7 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
     f.tow_fibre_volume_fraction = fb.number("tow_fibre_volume_fraction", f.tow_fibre_volume_fraction, Range::open_closed(0, 0.9069));
     const std::string stitch = fb.choice("stitch", {"tricot", "chain", "none"}, "tricot");
     f.stitch = stitch == "tricot" ? drape::StitchPattern::Tricot : stitch == "chain" ? drape::StitchPattern::Chain : drape::StitchPattern::None;
+    f.stitch_direction_deg = fb.number("stitch_direction_deg", 0.0, Range::closed(-90, 90));
     f.stitch_gauge = fb.number("stitch_gauge", 0.0, Range::non_negative());
     f.stitch_length = fb.number("stitch_length", 0.0, Range::non_negative());
     f.elements_across_tow = static_cast<int>(fb.integer("elements_across_tow", 2, 1, 16));
