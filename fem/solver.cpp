@@ -67,9 +67,34 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
       for (int c = 0; c < 3; ++c)
         if (pv.dofs[c]) fixed_mask_[3 * static_cast<std::size_t>(node) + c] = static_cast<std::uint8_t>(2 + k);
   }
+  // Picture-frame nodes: code 254, their frame coordinates kept per constrained DOF below.
+  std::vector<std::int32_t> frame_of_node(n, -1);
+  for (std::size_t k = 0; k < model_.picture_frames.size(); ++k) {
+    auto& pf = model_.picture_frames[k];
+    if (!(std::abs(dot(pf.arm1, pf.arm1) - 1) < 1e-9 && std::abs(dot(pf.arm2, pf.arm2) - 1) < 1e-9 &&
+          std::abs(dot(pf.arm1, pf.arm2)) < 1e-9))
+      throw InputError("", "boundary.picture_frame." + pf.name, "the arms must be orthogonal unit vectors");
+    for (auto node : pf.nodes) {
+      frame_of_node[static_cast<std::size_t>(node)] = static_cast<std::int32_t>(k);
+      for (int c = 0; c < 3; ++c) fixed_mask_[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)] = 254;
+    }
+  }
   for (std::size_t d = 0; d < 3 * n; ++d)
     if (fixed_mask_[d]) constrained_.push_back(d);
   constrained_vo_.resize(constrained_.size());
+  frame_dof_.assign(constrained_.size(), {});
+  {
+    auto X0 = x0.view();
+    for (std::size_t k = 0; k < constrained_.size(); ++k) {
+      const std::size_t d = constrained_[k], node = d / 3;
+      if (fixed_mask_[d] != 254) continue;
+      const auto& pf = model_.picture_frames[static_cast<std::size_t>(frame_of_node[node])];
+      const V3 r = V3::at(X0.data() + 3 * node) - pf.corner;
+      frame_dof_[k] = {frame_of_node[node], dot(r, pf.arm1), dot(r, pf.arm2)};
+    }
+  }
+  frame_c1_.resize(model_.picture_frames.size());
+  frame_c2_.resize(model_.picture_frames.size());
   zero_.assign(3 * n, 0.0);
   if (model_.velocities.size() > 250)
     throw InputError("", "boundary.velocity", "at most 250 prescribed-velocity sets");
@@ -399,11 +424,25 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   ext_old *= dtp, ext_new *= dt_new, damp_old *= dtp, damp_new *= dt_new, con_old *= dtp, con_new *= dt_new;
   ke *= 0.5;
   const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
+  for (std::size_t k = 0; k < model_.picture_frames.size(); ++k) {  // d(u1)/dt, d(u2)/dt at t^{n+1/2}
+    const auto& pf = model_.picture_frames[k];
+    const double g = picture_frame_angle(pf, t_half), gd = 0.5 * picture_frame_rate(pf, t_half);
+    const double cs = std::cos(0.5 * g), sn = std::sin(0.5 * g);
+    frame_c1_[k] = gd * (-sn * pf.arm1 + cs * pf.arm2);
+    frame_c2_[k] = gd * (cs * pf.arm1 - sn * pf.arm2);
+  }
   for (std::size_t k = 0; k < constrained_.size(); ++k) {
     const std::size_t d = constrained_[k];
     const std::uint8_t code = fixed_mask_[d];
     const double vo = constrained_vo_[k], m = mm[d], vfree = vel[d];
-    const double vp = code == 1 ? 0.0 : vpres[code - 2].arr()[d % 3];
+    double vp = 0.0;
+    if (code == 254) {
+      const FrameDof& fd = frame_dof_[k];
+      const auto f = static_cast<std::size_t>(fd.frame);
+      vp = (fd.xi * frame_c1_[f] + fd.eta * frame_c2_[f]).arr()[d % 3];
+    } else if (code > 1) {
+      vp = vpres[code - 2].arr()[d % 3];
+    }
     const double r = m * (vp - vfree) * inv_dt_mid;
     rr[d] = r;
     vel[d] = vp;

@@ -71,6 +71,12 @@ class ExplicitSolver {
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
   std::vector<V3> vpres_;
+  struct FrameDof {
+    std::int32_t frame = -1;
+    double xi = 0, eta = 0;  // reference coordinates along the frame's arms
+  };
+  std::vector<FrameDof> frame_dof_;       // per constrained DOF (frame = -1: not a frame DOF)
+  std::vector<V3> frame_c1_, frame_c2_;   // per frame: d(u1)/dt, d(u2)/dt this cycle
   std::vector<std::size_t> constrained_;  // DOFs with a fixed or prescribed velocity
   std::vector<double> constrained_vo_;    // their v^{n-1/2} during a cycle
   std::vector<double> zero_;              // [3*n] zeros for force arrays a model does not use

@@ -529,6 +529,24 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       ec.model.velocities.push_back(std::move(pv));
     }
   }
+  std::vector<double> frame_final_angles;
+  if (auto bc = root.table("boundary"))
+    for (const auto& t : bc->tables("picture_frame")) {
+      fem::PictureFrame pf;
+      pf.name = t.string("name");
+      pf.nodes = select_nodes(t, "nodes", mesh);
+      pf.corner = to_v3(t.vec3("corner"));
+      V3 a1 = to_v3(t.vec3_or("arm1", {1, 0, 0})), a2 = to_v3(t.vec3_or("arm2", {0, 1, 0}));
+      if (!(norm(a1) > 0) || !(norm(a2) > 0)) t.fail("arm1", "arms must not be zero");
+      a1 = normalized(a1), a2 = normalized(a2);
+      if (std::abs(dot(a1, a2)) > 1e-6) t.fail("arm2", "must be orthogonal to arm1");
+      pf.arm1 = a1, pf.arm2 = a2;
+      pf.arm_length = t.number("arm_length", Range::positive());
+      pf.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
+      frame_final_angles.push_back(t.number("final_shear_angle_deg", Range::open_closed(0, 80)) * M_PI / 180.0);
+      ec.frame_fabric_length.push_back(t.number("fabric_length", pf.arm_length, Range::positive()));
+      ec.model.picture_frames.push_back(std::move(pf));
+    }
   if (auto ld = root.table("load")) {
     ec.model.gravity = to_v3(ld->vec3_or("gravity", {0, 0, 0}));
     ec.model.gravity_ramp_time = ld->number("gravity_ramp_time", 0.0, Range::non_negative());
@@ -562,6 +580,11 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
   time.frame_interval = tc.number("frame_interval", time.end_time / 20, Range::positive());
   time.max_cycles = tc.integer("max_cycles", 0, 0, std::int64_t{1} << 50);
   time.energy_balance_limit = tc.number("energy_balance_limit", 0.05, Range::open_closed(0, 1));
+  for (std::size_t k = 0; k < ec.model.picture_frames.size(); ++k) {  // constant rate to the final angle at end_time
+    auto& pf = ec.model.picture_frames[k];
+    if (!(time.end_time > pf.ramp_time)) tc.fail("end_time", "must exceed the picture frame's ramp_time");
+    pf.shear_rate = frame_final_angles[k] / (time.end_time - 0.5 * pf.ramp_time);
+  }
 
   // Output.
   if (auto o = root.table("output")) {

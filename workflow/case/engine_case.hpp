@@ -130,6 +130,7 @@ struct EngineCase {
   std::vector<SummarySamples> samples;
   std::vector<BendingLengthProbe> bending;
   std::vector<SummaryMean> means;
+  std::vector<double> frame_fabric_length;  // per picture frame: side of the fabric for normalising
 };
 
 /// Reads and checks a case (throws InputError naming file and key). `overrides` are --set items.

@@ -208,6 +208,12 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     hc.add_xyz(t.name + "_displacement", "m");
   }
   for (const auto& r : ec.reactions) hc.add_xyz(r.name + "_reaction", "N");
+  for (const auto& pf : model.picture_frames) {
+    hc.add(pf.name + "_shear_angle_deg");
+    hc.add(pf.name + "_force_N");
+    hc.add(pf.name + "_shear_force_N");
+    hc.add(pf.name + "_normalised_shear_force_N_per_m");
+  }
   for (const auto& p : ec.probes) hc.add_xyz(p.name + "_displacement", "m");
   // Contact resultants are named by the contacts once they have run a cycle: the header is
   // written with the first row.
@@ -335,6 +341,29 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     }
     for (const auto& r : ec.reactions)
       for (double v : solver.reaction_force(r.nodes).arr()) row.push_back(v);
+    for (std::size_t k = 0; k < model.picture_frames.size(); ++k) {
+      // Crosshead force from the power the frame puts in: F = sum R.v / (dd/dt), d the crosshead
+      // travel, d = 2 L cos(theta) - sqrt(2) L, theta = 45 deg - gamma/2; shear force F / (2 cos theta).
+      const auto& pf = model.picture_frames[k];
+      const double g = fem::picture_frame_angle(pf, solver.time()), gd = fem::picture_frame_rate(pf, solver.time());
+      const double theta = 0.25 * M_PI - 0.5 * g, ddot = pf.arm_length * std::sin(theta) * gd;
+      double power = 0;
+      {
+        auto R = solver.reaction.view();
+        auto Vn = solver.v.view();
+        for (auto node : pf.nodes)
+          for (int c = 0; c < 3; ++c) {
+            const auto d = 3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c);
+            power += R[d] * Vn[d];
+          }
+      }
+      const double F = ddot > 0 ? power / ddot : 0.0, Fs = F / (2 * std::cos(theta));
+      const double Lf = ec.frame_fabric_length[k];
+      row.push_back(g * 180.0 / M_PI);
+      row.push_back(F);
+      row.push_back(Fs);
+      row.push_back(Fs * pf.arm_length / (Lf * Lf));
+    }
     for (const auto& p : ec.probes)
       for (double v : probe_disp(p.nodes).arr()) row.push_back(v);
     for (const auto& pe : shear_sets) row.push_back(shear_angle(pe));
