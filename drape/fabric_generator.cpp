@@ -37,8 +37,8 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   const double Lx = bl.size[0], Ly = bl.size[1];
   const double p = f.tow_pitch(), w = f.tow_width, t = f.tow_thickness();
   const double s = f.penetration_spacing(), g = f.gauge();
-  if (!(Lx > 2 * p && Ly > 2 * p))
-    throw InputError(file, "blanket.size", "the blanket must be larger than two tow pitches in x and y");
+  if (!(Lx >= p * (1 - 1e-9) && Ly >= p * (1 - 1e-9)))
+    throw InputError(file, prefix + "size", "the blanket must be at least one tow pitch long and wide");
   FabricModel fm;
   fm.tow_thickness = t;
   const std::array<double, 2> lo{bl.origin[0], bl.origin[1]}, hi{bl.origin[0] + Lx, bl.origin[1] + Ly};
@@ -116,6 +116,10 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
           }
         }
       auto node = [&](int i, int m, int kz) { return base + (kz * (nw + 1) + m) * (nl + 1) + i; };
+      for (int kz = 0; kz <= nt; ++kz) {
+        fm.tow_end_pins.push_back(node(0, nw / 2, kz));
+        fm.tow_end_pins.push_back(node(nl, nw / 2, kz));
+      }
       const auto tow = static_cast<std::int32_t>(fm.n_tows++);
       fm.ply_of_tow.push_back(static_cast<int>(q));
       for (int kz = 0; kz < nt; ++kz)
@@ -156,7 +160,7 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       }
       ++fm.n_penetrations;
     }
-  if (fm.n_penetrations == 0) throw InputError(file, "blanket.size", "the blanket holds no stitch penetration");
+  if (fm.n_penetrations == 0) throw InputError(file, prefix + "size", "the blanket holds no stitch penetration");
   fm.stitch_I_part = mesh.add_part(prefix + "stitch_I");
   fm.stitch_leg_part = mesh.add_part(prefix + "stitch_legs");
   const bool tricot = f.stitch == StitchPattern::Tricot;

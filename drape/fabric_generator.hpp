@@ -32,6 +32,10 @@ struct FabricModel {
   std::vector<int> ply_of_tow;            // per tow
   std::vector<StitchConnection> connections;
   std::vector<std::int32_t> stitch_nodes;
+  /// The two end lines of every tow on its centre line (through the thickness): pins about which a
+  /// tow end may rotate (a picture frame holds tows by these). Centred for an even
+  /// elements_across_tow.
+  std::vector<std::int32_t> tow_end_pins;
   std::size_t n_tows = 0, n_dropped_tows = 0;
   std::size_t n_penetrations = 0;
   double tow_thickness = 0;
@@ -39,7 +43,7 @@ struct FabricModel {
 
 /// Appends the blanket to `mesh` (parts "<prefix>ply<k>", "<prefix>stitch_I", "<prefix>stitch_Lambda",
 /// "<prefix>stitch_legs"). Tows shorter than two elements at the corners are dropped (counted).
-/// Throws InputError for an inconsistent fabric or a blanket smaller than one stitch cell.
+/// Throws InputError for an inconsistent fabric or a blanket smaller than one tow pitch.
 FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& fabric, const BlanketSpec& blanket,
                              const std::string& file = "", const std::string& prefix = "");
 

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -272,5 +273,43 @@ TEST(CliRegression, CantileverBendingMatchesBeamTheoryAndCalibrates) {
   const auto& last = cal["runs"].back();
   EXPECT_NEAR(last["bending_length_m"].get<double>(), last["beam_theory_bending_length_m"].get<double>(),
               0.05 * last["beam_theory_bending_length_m"].get<double>());
+  fs::remove_all(out);
+}
+
+// Picture frame on the unstitched 6.64 mm unit cell with pinned tow ends: the tows rotate freely
+// until neighbouring tows meet, at the gap-closing angle acos(w / p) = 14.1 deg (w = 3.22 mm,
+// p = 3.32 mm); before it (after the start-up ramp) the shear force stays below 1 % of its value
+// at 28 deg, after it rises.
+TEST(CliRegression, PictureFrameForceRisesAtTheGapClosingAngle) {
+  const fs::path out = fresh_dir("picture_frame");
+  const Result r = run_cli({"-q", "run", (kSource / "cases/drape/picture_frame_unstitched.toml").string(), "-o",
+                            out.string(), "--set", "boundary.picture_frame[0].final_shear_angle_deg=30",
+                            "--set", "time.end_time=0.03", "--set", "output.figures=false", "--set",
+                            "output.report=false"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(out / "history.csv");
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> cols;
+  {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cols.push_back(c);
+  }
+  const auto col = [&](const std::string& n) { return std::find(cols.begin(), cols.end(), n) - cols.begin(); };
+  const auto ca = col("frame_shear_angle_deg"), cf = col("frame_normalised_shear_force_N_per_m");
+  ASSERT_LT(static_cast<std::size_t>(cf), cols.size());
+  double before = 0, at28 = 0;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) v.push_back(std::stod(c));
+    const double g = v[static_cast<std::size_t>(ca)], f = v[static_cast<std::size_t>(cf)];
+    if (g > 4.0 && g < 12.5) before = std::max(before, std::abs(f));  // after the start-up ramp
+    if (g > 27.5 && g < 28.5) at28 = f;
+  }
+  const double gap_closing = std::acos(3.22 / 3.32) * 180 / M_PI;
+  EXPECT_NEAR(gap_closing, 14.1, 0.1);
+  EXPECT_GT(at28, 0.0);
+  EXPECT_LT(before, 0.01 * at28) << "the tows must rotate freely before their gaps close";
   fs::remove_all(out);
 }

@@ -41,6 +41,10 @@ std::array<bool, 3> read_dofs(const TableReader& t, std::string_view key, std::a
   return d;
 }
 
+// Tow end pins of the [[mesh.fabric]] blankets of the case being read, by fabric name (reset by
+// every load_engine_case; a selector `tow_end_pins = "name"` picks them).
+std::map<std::string, std::vector<std::int32_t>> g_tow_end_pins;
+
 // Node selection: the intersection of the criteria given (part, box, plane); "all" if none.
 std::vector<std::int32_t> select_nodes(const TableReader& owner, std::string_view key, const fem::Mesh& mesh) {
   auto sel = owner.table(key);
@@ -89,6 +93,34 @@ std::vector<std::int32_t> select_nodes(const TableReader& owner, std::string_vie
     const double value = sel->number("value", {});
     for (std::size_t i = 0; i < n; ++i)
       if (std::abs(mesh.coords[3 * i + static_cast<std::size_t>(a)] - value) > tol) keep[i] = 0;
+  }
+  if (sel->has("outline")) {  // on the x-y outline of the bounding box of the selection so far
+    any = true;
+    if (!sel->boolean("outline", false)) sel->fail("outline", "only `outline = true` is meaningful");
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (std::size_t i = 0; i < n; ++i)
+      if (keep[i])
+        for (int c = 0; c < 2; ++c) {
+          lo[c] = std::min(lo[c], mesh.coords[3 * i + static_cast<std::size_t>(c)]);
+          hi[c] = std::max(hi[c], mesh.coords[3 * i + static_cast<std::size_t>(c)]);
+        }
+    for (std::size_t i = 0; i < n; ++i) {
+      bool on = false;
+      for (int c = 0; c < 2; ++c) {
+        const double v = mesh.coords[3 * i + static_cast<std::size_t>(c)];
+        on = on || std::abs(v - lo[c]) <= tol || std::abs(v - hi[c]) <= tol;
+      }
+      if (!on) keep[i] = 0;
+    }
+  }
+  if (sel->has("tow_end_pins")) {
+    any = true;
+    const std::string fabric = sel->string("tow_end_pins");
+    const auto it = g_tow_end_pins.find(fabric);
+    if (it == g_tow_end_pins.end()) sel->fail("tow_end_pins", "no [[mesh.fabric]] named '" + fabric + "'");
+    std::vector<char> pin(n, 0);
+    for (auto nd : it->second) pin[static_cast<std::size_t>(nd)] = 1;
+    for (std::size_t i = 0; i < n; ++i) keep[i] &= pin[i];
   }
   if (sel->has("all")) {
     any = true;
@@ -306,6 +338,7 @@ void read_contacts(const TableReader& root, EngineCase& ec, const std::string& f
 
 EngineCase load_engine_case(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   CaseDocument doc = CaseDocument::load(file, overrides);
+  g_tow_end_pins.clear();
   const std::string fname = file.string();
   TableReader root(doc, doc.root(), "");
   EngineCase ec;
@@ -420,6 +453,8 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
     }
     fe.angles = f.ply_angles_deg;
     drape::validate(f, fname, fb.path());
+    if (!(bl.size[0] >= f.tow_pitch() * (1 - 1e-9) && bl.size[1] >= f.tow_pitch() * (1 - 1e-9)))
+      fb.fail("size", "the blanket must be at least one tow pitch (" + std::to_string(f.tow_pitch()) + " m) long and wide");
     if (fe.name.empty() || fe.name.find_first_of(" ./\\") != std::string::npos)
       fb.fail("name", "must be a non-empty name without spaces, dots or slashes (it prefixes the part names)");
     fe.model = drape::generate_blanket(mesh, f, bl, fname, fe.name + "_");
@@ -433,6 +468,8 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
     for (auto& c : fe.model.connections)
       c.stitch_node = new_of_old[static_cast<std::size_t>(c.stitch_node)], c.tow_node = new_of_old[static_cast<std::size_t>(c.tow_node)];
     for (auto& nd : fe.model.stitch_nodes) nd = new_of_old[static_cast<std::size_t>(nd)];
+    for (auto& nd : fe.model.tow_end_pins) nd = new_of_old[static_cast<std::size_t>(nd)];
+    g_tow_end_pins[fe.name] = fe.model.tow_end_pins;
   }
   mesh.fill_default_user_ids();
 
