@@ -14,7 +14,7 @@
 namespace ncfsim::drape {
 
 struct StitchConnectionSettings {
-  double sliding_force = 0.5;     // N per connection (> 0)
+  double sliding_force = 0.05;    // N per connection (> 0), docs/fabric-data.md
   double stiffness = 0;           // N/m; 0: the stability limit below
   double stiffness_scale = 0.1;   // k <= scale * min(m_a, m_b) / dt^2: never lowers the stable step
 };

@@ -448,7 +448,7 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       fe.law_I = fb.string("stitch_law_I");
       fe.law_Lambda = f.stitch == drape::StitchPattern::Tricot ? fb.string("stitch_law_Lambda") : fe.law_I;
       fe.law_legs = fb.string("stitch_law_legs", fe.law_I);
-      fe.connection.sliding_force = fb.number("connection_sliding_force", 0.5, Range::positive());
+      fe.connection.sliding_force = fb.number("connection_sliding_force", 0.05, Range::positive());
       fe.connection.stiffness = fb.number("connection_stiffness", 0.0, Range::non_negative());
     }
     fe.angles = f.ply_angles_deg;
