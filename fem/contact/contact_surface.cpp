@@ -62,7 +62,6 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
                              grp.name + "' holds no hexahedra (contact surfaces are hex faces)");
 
   ContactSurface s;
-  std::vector<std::int32_t> seg_hex;
   std::vector<FaceRecord> faces;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     faces.clear();
@@ -100,7 +99,7 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
         s.seg_elem_user_id.push_back(mesh.hex_user_id.size() == mesh.hexes.size()
                                          ? mesh.hex_user_id[static_cast<std::size_t>(faces[i].hex)]
                                          : faces[i].hex + 1);
-        seg_hex.push_back(faces[i].hex);
+        s.seg_hex.push_back(faces[i].hex);
       }
       i = j;
     }

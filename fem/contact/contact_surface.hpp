@@ -21,6 +21,7 @@ struct ContactSurface {
   std::vector<double>
       seg_elem_thickness;  // [n_seg] owning hexahedron's thickness normal to the face at x0, m
   std::vector<std::int64_t> seg_elem_user_id;  // [n_seg] for messages
+  std::vector<std::int32_t> seg_hex;           // [n_seg] owning hexahedron (index into Mesh::hexes)
   std::vector<std::int32_t> node;              // [n_snode] mesh node of each surface node
   std::vector<std::int32_t> node_group;        // [n_snode] group of each surface node
   std::vector<double> node_area;  // [n_snode] tributary area at x0 (quarter of each segment), m^2

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 #include "fem/contact/contact_force_kernel.hpp"
 #include "fem/errors.hpp"
@@ -62,8 +63,40 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
     for (std::size_t h = 0; h < ng; ++h) in_pair = in_pair || pair_of_[h * ng + g] >= 0;
     if (in_pair) active_seg_.push_back(static_cast<std::int32_t>(s));
   }
+  // Outer faces of the same hexahedron sharing an edge with each segment (the closest-feature
+  // test of the narrow phase).
+  seg_adjacent_.assign(4 * n_seg, -1);
+  {
+    std::vector<std::int32_t> by_hex(n_seg);
+    std::iota(by_hex.begin(), by_hex.end(), 0);
+    std::stable_sort(by_hex.begin(), by_hex.end(), [&](std::int32_t a, std::int32_t b) {
+      return surf_.seg_hex[static_cast<std::size_t>(a)] <
+             surf_.seg_hex[static_cast<std::size_t>(b)];
+    });
+    for (std::size_t r = 0; r < n_seg;) {
+      std::size_t r_end = r + 1;
+      while (r_end < n_seg && surf_.seg_hex[static_cast<std::size_t>(by_hex[r_end])] ==
+                                  surf_.seg_hex[static_cast<std::size_t>(by_hex[r])])
+        ++r_end;
+      for (std::size_t u = r; u < r_end; ++u) {
+        const auto a = static_cast<std::size_t>(by_hex[u]);
+        int n_adj = 0;
+        for (std::size_t w = r; w < r_end; ++w) {
+          const auto b = static_cast<std::size_t>(by_hex[w]);
+          int shared = 0;
+          for (int k = 0; k < 4; ++k)
+            for (int m = 0; m < 4; ++m)
+              shared += surf_.seg_nodes[4 * a + k] == surf_.seg_nodes[4 * b + m] ? 1 : 0;
+          if (a != b && shared == 2 && n_adj < 4)
+            seg_adjacent_[4 * a + static_cast<std::size_t>(n_adj++)] = static_cast<std::int32_t>(b);
+        }
+      }
+      r = r_end;
+    }
+  }
   x_sorted_.assign(3 * n_node, 0.0);
   tangential_.clear();
+  last_seg_.clear();
   facet_start_.assign(n_node + 1, 0);
   node_mass_.resize(setup.mesh->n_nodes());
   for (std::size_t i = 0; i < node_mass_.size(); ++i) node_mass_[i] = setup.mass[3 * i];
@@ -119,6 +152,33 @@ void PenaltyContact::compute_frames(const double* x, std::size_t blk) {
   }
 }
 
+bool PenaltyContact::closer_adjacent_face(const double* x, const std::int32_t* adj,
+                                          const double* fn, int nf, double px, double py, double pz,
+                                          double pen, bool in_contact) {
+  const std::int64_t cycle = stats_.n_cycles;
+  const double thick = cfg_.thickness;
+  for (int a = 0; a < 4 && adj[a] >= 0; ++a) {
+    const auto q = static_cast<std::size_t>(adj[a]);
+    const auto blk = q / kFrameLanes;
+    if (frame_stamp_[blk] != cycle) compute_frames(x, blk), frame_stamp_[blk] = cycle;
+    const SegmentFrame& F = frame_[q];
+    bool faces = false;
+    for (int j = 0; j < nf; ++j)
+      faces = faces || fn[3 * j] * F.n[0] + fn[3 * j + 1] * F.n[1] + fn[3 * j + 2] * F.n[2] <
+                           kOpposedNormals;
+    if (!faces) continue;
+    // o: distance of the node in front of that face's plane (< 0: behind it); band: how far the
+    // segment's edge tolerance reaches past the shared edge (the hexahedron's thickness normal
+    // to that face times edge_tolerance).
+    const double o = project_on_segment(F, px, py, pz).gap - thick;
+    const double band = cfg_.edge_tolerance * surf_.seg_elem_thickness[q];
+    const bool closest = o <= 0 && pen <= -o;
+    const bool kept = in_contact && pen <= band;
+    if (!closest && !kept) return true;
+  }
+  return false;
+}
+
 void PenaltyContact::sort_segments(const double* x) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t ng = n_groups_, n_node = surf_.n_nodes(), n_act = active_seg_.size();
@@ -145,6 +205,7 @@ void PenaltyContact::sort_segments(const double* x) {
   // the facet numbering, and with it the friction state, is stable from one sort to the next).
   facet_start_old_.swap(facet_start_);
   tangential_old_.swap(tangential_);
+  last_seg_old_.swap(last_seg_);
   facet_start_.resize(n_node + 1);
   facet_start_[0] = 0;
   for (std::size_t e = 0; e < n_node; ++e) {
@@ -174,15 +235,19 @@ void PenaltyContact::sort_segments(const double* x) {
             unit[j][k];
   }
 
-  // Friction state carried over facet by facet.
+  // Friction state and last contact segment carried over facet by facet.
   tangential_.assign(3 * static_cast<std::size_t>(facet_start_[n_node]), 0.0);
-  for (std::size_t e = 0; e < n_node; ++e) {
-    const std::int32_t n_keep = std::min(facet_start_old_[e + 1] - facet_start_old_[e],
-                                         facet_start_[e + 1] - facet_start_[e]);
-    for (std::int32_t k = 0; k < 3 * n_keep; ++k)
-      tangential_[3 * static_cast<std::size_t>(facet_start_[e]) + static_cast<std::size_t>(k)] =
-          tangential_old_[3 * static_cast<std::size_t>(facet_start_old_[e]) +
-                          static_cast<std::size_t>(k)];
+  last_seg_.assign(static_cast<std::size_t>(facet_start_[n_node]), -1);
+  if (!last_seg_old_.empty()) {
+    for (std::size_t e = 0; e < n_node; ++e) {
+      const auto f_new = static_cast<std::size_t>(facet_start_[e]);
+      const auto f_old = static_cast<std::size_t>(facet_start_old_[e]);
+      const auto n_keep = static_cast<std::size_t>(std::min(
+          facet_start_old_[e + 1] - facet_start_old_[e], facet_start_[e + 1] - facet_start_[e]));
+      for (std::size_t k = 0; k < 3 * n_keep; ++k)
+        tangential_[3 * f_new + k] = tangential_old_[3 * f_old + k];
+      for (std::size_t k = 0; k < n_keep; ++k) last_seg_[f_new + k] = last_seg_old_[f_old + k];
+    }
   }
 
   // Candidates of every surface node.
@@ -277,10 +342,12 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   const std::int32_t* sn = surf_.seg_nodes.data();
   const std::int32_t* sg = surf_.seg_group.data();
   const SegmentFrame* fr = frame_.data();
+  const std::int32_t* seg_adj = seg_adjacent_.data();
   std::int64_t* stamp = frame_stamp_.data();
   const std::int64_t cycle = stats_.n_cycles;
   const double* mu_of = mu_of_.data();
   double* tang = tangential_.data();
+  std::int32_t* last = last_seg_.data();
   ContactBatch& B = batch_;
   B.n = 0;
   std::int64_t n_active = 0;
@@ -310,12 +377,15 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     const std::int32_t b = start[e], end = start[e + 1];
     const int nf = n_facets[e];
     double* ft_node = tang + 3 * static_cast<std::size_t>(facet_start[e]);
+    std::int32_t* last_node = last + facet_start[e];
     if (b == end) {
       for (int j = 0; j < 3 * nf; ++j) ft_node[j] = 0;
+      for (int j = 0; j < nf; ++j) last_node[j] = -1;
       continue;
     }
     const auto i = static_cast<std::size_t>(node[e]);
     const double px = x[3 * i], py = x[3 * i + 1], pz = x[3 * i + 2];
+    const double* fn_node = &facet_[3 * kMaxFacets * e];
     std::int32_t best[kMaxFacets] = {-1, -1, -1};
     double best_gap[kMaxFacets], bxi[kMaxFacets] = {}, beta[kMaxFacets] = {};
     for (double& g : best_gap) g = -std::numeric_limits<double>::max();
@@ -329,8 +399,15 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
       const SegmentFrame& F = fr[s];
       const SegmentProjection pr = project_on_segment(F, px, py, pz);
       // Branch-free test: candidates pass or fail unpredictably.
-      const bool hit = (std::abs(pr.xi) <= lim) & (std::abs(pr.eta) <= lim) & (pr.gap < thick) &
-                       (pr.gap > -F.depth) & (pr.gap > best_gap[j]);
+      bool hit = (std::abs(pr.xi) <= lim) & (std::abs(pr.eta) <= lim) & (pr.gap < thick) &
+                 (pr.gap > -F.depth) & (pr.gap > best_gap[j]);
+      // Closest feature (see closer_adjacent_face): a tow-end node lying on a thin tow's top
+      // face also projects onto the tow's side face (at its top edge), up to half the tow width
+      // 'deep', and its end facet faces that side: the top face is the contact, the side is not.
+      const std::int32_t* adj = seg_adj + 4 * static_cast<std::size_t>(s);
+      if (hit && adj[0] >= 0)
+        hit = !closer_adjacent_face(x, adj, fn_node, nf, px, py, pz, thick - pr.gap,
+                                    last_node[j] == s);
       best[j] = hit ? s : best[j];
       best_gap[j] = hit ? pr.gap : best_gap[j];
       bxi[j] = hit ? pr.xi : bxi[j];
@@ -341,6 +418,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     const std::size_t row = static_cast<std::size_t>(group[e]) * ng;
     for (int j = 0; j < nf; ++j) {
       double* ft = ft_node + 3 * j;
+      last_node[j] = best[j];
       if (best[j] < 0) {
         ft[0] = ft[1] = ft[2] = 0;
         continue;

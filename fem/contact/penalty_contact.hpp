@@ -16,7 +16,9 @@
 //     first use in the cycle, kFrameLanes segments at a time in SIMD lanes (SegmentFrameBlock).
 //  3. Narrow phase per surface node and facet: projection on each candidate; the facet's
 //     contact is the segment the node projects into (with edge_tolerance) with the largest gap
-//     below `thickness` and above -depth. One contact per facet: a node on the edge of one tow,
+//     below `thickness` and above -depth, and that passes the closest-feature test against the
+//     other faces of its hexahedron (closer_adjacent_face: a node on a thin tow's top face is not
+//     pushed out through the tow's side). One contact per facet: a node on the edge of one tow,
 //     pinched between the next tow's side and the ply above, is pushed by both; a node on a flat
 //     surface over a seam between two segments is pushed once.
 //  4. Forces of the active contacts in batches (contact_forces, a branch-free SIMD kernel):
@@ -78,6 +80,16 @@ class PenaltyContact final : public ContactAlgorithm {
  private:
   void sort_segments(const double* x);                      // broad phase at positions x
   void compute_frames(const double* x, std::size_t block);  // frames of one block at x
+  /// Closest-feature test of a contact of penetration pen on a segment, against the outer faces
+  /// adjacent to it in the same hexahedron (adj[4], -1 padded) that are opposed to one of the
+  /// node's nf facets (fn[nf][3]). True (not the contact) when, for such a face, the node at p
+  /// is neither behind its plane by at least pen (then the segment is the nearest way out) nor
+  /// holding this contact from the last cycle (in_contact) with pen <= edge_tolerance * the
+  /// hexahedron's thickness normal to that face (a node sliding past the convex edge into the
+  /// segment's edge-tolerance band keeps its contact; one arriving there from the side, or deep
+  /// behind the segment's plane but outside the body, gets none).
+  bool closer_adjacent_face(const double* x, const std::int32_t* adj, const double* fn, int nf,
+                            double px, double py, double pz, double pen, bool in_contact);
 
   PenaltyContactConfig cfg_;
   ContactSurface surf_;
@@ -88,6 +100,8 @@ class PenaltyContact final : public ContactAlgorithm {
   double margin_ = 0;                  // search margin, m
   double inv_dt0_sq_ = 0;              // 1 / dt0^2
   std::vector<double> depth_;          // [n_seg] max_penetration * element thickness
+  std::vector<std::int32_t> seg_adjacent_;  // [n_seg][4] outer faces of the same hexahedron
+                                            // sharing an edge, -1 padded
 
   // State and work arrays, sized in initialise(), reused every cycle.
   std::vector<double> x_sorted_;           // [n_snode][3] positions at the last sort
@@ -95,6 +109,8 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<std::int32_t> facet_start_;  // [n_snode + 1] first facet of each surface node
   std::vector<double> tangential_old_;     // the two above before the last sort (carried over)
   std::vector<std::int32_t> facet_start_old_;
+  std::vector<std::int32_t> last_seg_;      // [n_facet] contact segment of each node facet in the
+  std::vector<std::int32_t> last_seg_old_;  // last cycle, -1: none (and before the last sort)
   std::vector<double> node_mass_;          // [n_nodes] lumped nodal masses (fixed after set-up), kg
   std::vector<std::int32_t> cand_start_;   // [n_snode + 1] CSR into cand_seg_
   std::vector<std::int32_t> cand_seg_;     // candidate segments, node by node
