@@ -2,13 +2,38 @@
 
 #include <cmath>
 
+#include "fem/hex8_basis.hpp"
+
 namespace ncfsim::fem {
 
 namespace {
-constexpr double S[8][8] = {
-    {1, 1, 1, 1, 1, 1, 1, 1},      {-1, 1, 1, -1, -1, 1, 1, -1},  {-1, -1, 1, 1, -1, -1, 1, 1},
-    {-1, -1, -1, -1, 1, 1, 1, 1},  {1, 1, -1, -1, -1, -1, 1, 1},  {1, -1, -1, 1, -1, 1, 1, -1},
-    {1, -1, 1, -1, 1, -1, 1, -1},  {-1, 1, -1, 1, 1, -1, 1, -1}};
+
+// F M of element e (deformation gradient at the centre times the reference material axes, the
+// kernel's F = J J_ref^{-1}), row-major; returns det F.
+double centre_FM(const Hex8Block& b, const double* x, std::size_t e, double FM[9]) {
+  const std::size_t n = b.n;
+  double J[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+  for (int I = 0; I < 8; ++I) {
+    const std::size_t node = static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * n + e]);
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) J[3 * r + k] += 0.125 * kHex8Sign[k + 1][I] * x[3 * node + static_cast<std::size_t>(r)];
+  }
+  double F[9];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      double s = 0;
+      for (int k = 0; k < 3; ++k) s += J[3 * r + k] * b.jac_inv0[static_cast<std::size_t>(3 * k + c) * n + e];
+      F[3 * r + c] = s;
+    }
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      double s = 0;
+      for (int k = 0; k < 3; ++k) s += F[3 * r + k] * b.mat_axes[static_cast<std::size_t>(3 * k + c) * n + e];
+      FM[3 * r + c] = s;
+    }
+  return F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+}
+
 }  // namespace
 
 double von_mises(const double s[6]) {
@@ -19,28 +44,8 @@ double von_mises(const double s[6]) {
 void hex8_output_fields(const Hex8Block& b, const double* x, double* cauchy, double* vm, double* fibre) {
   const std::size_t n = b.n;
   for (std::size_t e = 0; e < n; ++e) {
-    // Centre Jacobian columns a_1..a_3, F = J J_ref^{-1} (as in the kernel).
-    double J[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    for (int I = 0; I < 8; ++I) {
-      const std::size_t node = static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * n + e]);
-      for (int r = 0; r < 3; ++r)
-        for (int k = 0; k < 3; ++k) J[3 * r + k] += 0.125 * S[k + 1][I] * x[3 * node + static_cast<std::size_t>(r)];
-    }
-    double F[9], FM[9];
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) {
-        double s = 0;
-        for (int k = 0; k < 3; ++k) s += J[3 * r + k] * b.jac_inv0[static_cast<std::size_t>(3 * k + c) * n + e];
-        F[3 * r + c] = s;
-      }
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) {
-        double s = 0;
-        for (int k = 0; k < 3; ++k) s += F[3 * r + k] * b.mat_axes[static_cast<std::size_t>(3 * k + c) * n + e];
-        FM[3 * r + c] = s;
-      }
-    const double detF = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
-                        F[2] * (F[3] * F[7] - F[4] * F[6]);
+    double FM[9];
+    const double detF = centre_FM(b, x, e, FM);
     const double* st = b.stress.data();
     const double Sm[9] = {st[e], st[3 * n + e], st[5 * n + e], st[3 * n + e], st[n + e],
                           st[4 * n + e], st[5 * n + e], st[4 * n + e], st[2 * n + e]};
@@ -62,28 +67,10 @@ void hex8_output_fields(const Hex8Block& b, const double* x, double* cauchy, dou
 }
 
 void hex8_fibre_direction(const Hex8Block& b, const double* x, std::size_t e, double out[3]) {
-  const std::size_t n = b.n;
-  double J[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-  for (int I = 0; I < 8; ++I) {
-    const std::size_t node = static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * n + e]);
-    for (int r = 0; r < 3; ++r)
-      for (int k = 0; k < 3; ++k) J[3 * r + k] += 0.125 * S[k + 1][I] * x[3 * node + static_cast<std::size_t>(r)];
-  }
-  // F M e1 = J (J_ref^{-1} M e1)
-  double m1[3];
-  for (int k = 0; k < 3; ++k) {
-    double s = 0;
-    for (int j = 0; j < 3; ++j)
-      s += b.jac_inv0[static_cast<std::size_t>(3 * k + j) * n + e] * b.mat_axes[static_cast<std::size_t>(3 * j) * n + e];
-    m1[k] = s;
-  }
-  double len = 0;
-  for (int r = 0; r < 3; ++r) {
-    out[r] = J[3 * r] * m1[0] + J[3 * r + 1] * m1[1] + J[3 * r + 2] * m1[2];
-    len += out[r] * out[r];
-  }
-  len = std::sqrt(len);
-  for (int r = 0; r < 3; ++r) out[r] /= len;
+  double FM[9];
+  centre_FM(b, x, e, FM);
+  const double len = std::sqrt(FM[0] * FM[0] + FM[3] * FM[3] + FM[6] * FM[6]);
+  out[0] = FM[0] / len, out[1] = FM[3] / len, out[2] = FM[6] / len;
 }
 
 }  // namespace ncfsim::fem

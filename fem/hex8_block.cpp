@@ -10,6 +10,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "fem/errors.hpp"
+#include "fem/hex8_basis.hpp"
 #include "fem/simd_batch.hpp"
 
 namespace ncfsim::fem {
@@ -18,12 +19,7 @@ namespace {
 
 constexpr int CH = 32;  // elements per chunk: the chunk scratch (~20 KB) stays in L1
 
-// Sign vectors of the trilinear basis 1, xi, eta, zeta, eta*zeta, zeta*xi, xi*eta, xi*eta*zeta at
-// the 8 nodes (VTK order).
-constexpr double S[8][8] = {
-    {1, 1, 1, 1, 1, 1, 1, 1},      {-1, 1, 1, -1, -1, 1, 1, -1},  {-1, -1, 1, 1, -1, -1, 1, 1},
-    {-1, -1, -1, -1, 1, 1, 1, 1},  {1, 1, -1, -1, -1, -1, 1, 1},  {1, -1, -1, 1, -1, 1, 1, -1},
-    {1, -1, 1, -1, 1, -1, 1, -1},  {-1, 1, -1, 1, 1, -1, 1, -1}};
+constexpr const auto& S = kHex8Sign;
 
 struct Vec3 {
   double x, y, z;

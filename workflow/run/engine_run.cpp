@@ -42,6 +42,12 @@ V3 tool_axis(const fem::RigidTool& t) {
 
 struct HistoryColumns {
   std::vector<std::string> names;
+  /// Index of a column, -1 when absent.
+  int index(const std::string& name) const {
+    for (std::size_t c = 0; c < names.size(); ++c)
+      if (names[c] == name) return static_cast<int>(c);
+    return -1;
+  }
   void add(std::string n) { names.push_back(std::move(n)); }
   void add_xyz(const std::string& prefix, const std::string& unit) {
     for (const char* c : {"x", "y", "z"}) add(prefix + "_" + c + "_" + unit);
@@ -319,8 +325,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     if (ss.bias_extension_analytic) analytic = &ss;
   int analytic_x = -1;
   if (analytic) {
-    for (std::size_t c = 0; c < hc.names.size(); ++c)
-      if (hc.names[c] == analytic->x) analytic_x = static_cast<int>(c);
+    analytic_x = hc.index(analytic->x);
     if (analytic_x < 0)
       throw InputError(ec.file.string(), "output.sample.x", "no history column '" + analytic->x + "' (probes: <name>_displacement_x_m)");
     hc.add("analytic_shear_angle_deg");
@@ -451,11 +456,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
       summary[bp.name + "_axial_modulus_Pa"] = bs.E1;
     }
     for (const auto& sm : ec.means) {
-      int c = -1, cp = -1;
-      for (std::size_t k = 0; k < hc.names.size(); ++k) {
-        if (hc.names[k] == sm.column) c = static_cast<int>(k);
-        if (hc.names[k] == sm.per_column) cp = static_cast<int>(k);
-      }
+      const int c = hc.index(sm.column), cp = hc.index(sm.per_column);
       double sum = 0;
       std::size_t n = 0;
       const std::vector<double>*first = nullptr, *last = nullptr;
@@ -477,17 +478,12 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
         summary[sm.name + "_error"] = "no history column '" + (c < 0 ? sm.column : sm.per_column) + "'";
     }
     for (const auto& ss : ec.samples) {
-      const auto col = [&](const std::string& name) -> int {
-        for (std::size_t c = 0; c < hc.names.size(); ++c)
-          if (hc.names[c] == name) return static_cast<int>(c);
-        return -1;
-      };
-      const int cx = col(ss.x);
+      const int cx = hc.index(ss.x);
       for (double at : ss.at) {
         const std::string tag = fmt::format("_at_{:g}{}", at, ss.x_unit);
         const double xv = at / ss.x_display_scale;
         for (const auto& [label, column] : ss.columns) {
-          const int cy = col(column);
+          const int cy = hc.index(column);
           double val = std::numeric_limits<double>::quiet_NaN();
           for (std::size_t r = 1; cx >= 0 && cy >= 0 && r < kept_rows.size(); ++r) {
             const double x0 = kept_rows[r - 1][static_cast<std::size_t>(cx)], x1 = kept_rows[r][static_cast<std::size_t>(cx)];
