@@ -22,6 +22,18 @@ struct Handle {
   Handle& operator=(const Handle&) = delete;
 };
 
+// Read-only access that takes no HDF5 file lock, so that reading a running simulation's results
+// never blocks its writer (which opens and closes the file at every frame).
+hid_t open_unlocked(const std::filesystem::path& file) {
+  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+#if H5_VERSION_GE(1, 10, 7)
+  H5Pset_file_locking(fapl, 0, 1);
+#endif
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, fapl);
+  H5Pclose(fapl);
+  return f;
+}
+
 [[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
   throw std::runtime_error(file.string() + ": " + what);
 }
@@ -72,7 +84,7 @@ bool is_group(hid_t loc, const std::string& name) {
 
 ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
   if (!std::filesystem::exists(path_)) fail(path_, "no such file");
-  Handle f(H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  Handle f(open_unlocked(path_), H5Fclose);
   if (f.id < 0) fail(path_, "not a readable HDF5 file");
   {
     Handle a(H5Aopen(f.id, "n_frames", H5P_DEFAULT), H5Aclose);
@@ -96,7 +108,7 @@ ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
 
 StoredFrame ResultReader::frame(std::size_t index) const {
   if (index >= n_frames_) fail(path_, "frame " + std::to_string(index) + " not in the file");
-  Handle f(H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  Handle f(open_unlocked(path_), H5Fclose);
   if (f.id < 0) fail(path_, "not a readable HDF5 file");
   const std::string gname = "/frames/" + detail::zero_padded(index, 6);
   Handle g(H5Gopen2(f.id, gname.c_str(), H5P_DEFAULT), H5Gclose);

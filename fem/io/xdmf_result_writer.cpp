@@ -10,6 +10,9 @@
 #include "fem/io/io_detail.hpp"
 #include "fem/io/result_writers.hpp"
 
+#include <chrono>
+#include <thread>
+
 namespace ncfsim::fem::io {
 
 namespace {
@@ -289,7 +292,14 @@ void XdmfResultWriter::Impl::write_frame_h5(const Frame& frame, const std::strin
   SilenceH5Errors silence;
   const H5Where root = at("/");
   H5Id fapl = make_fapl(h5);
-  H5Id file(h5_check_id(H5Fopen(h5.c_str(), H5F_ACC_RDWR, fapl.get()), root, "H5Fopen"), H5Fclose);
+  // A reader that holds the file between frames (ParaView, h5py) keeps HDF5's lock: wait for it
+  // (up to ~10 s) rather than losing the frame.
+  hid_t fid = H5Fopen(h5.c_str(), H5F_ACC_RDWR, fapl.get());
+  for (int attempt = 0; fid < 0 && attempt < 200; ++attempt) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    fid = H5Fopen(h5.c_str(), H5F_ACC_RDWR, fapl.get());
+  }
+  H5Id file(h5_check_id(fid, root, "H5Fopen"), H5Fclose);
   {
     // A group left by an earlier failed attempt at this frame is replaced.
     const H5Where where = at(group);

@@ -395,13 +395,18 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   const fem::io::ResultMesh rmesh = result_mesh(solver);
   if (ec.output.xdmf) xdmf = std::make_unique<fem::io::XdmfResultWriter>(dir, rmesh);
   if (ec.output.vtu) vtu = std::make_unique<fem::io::VtuSeriesWriter>(dir, rmesh);
-  std::size_t frames = 0;
-  auto write_frame = [&] {
+  std::size_t frames = 0, frame_errors = 0;
+  auto write_frame = [&] {  // a frame that cannot be written is reported, the run goes on
     if (!xdmf && !vtu) return;
     const fem::io::Frame fr = make_frame(solver);
-    if (xdmf) xdmf->write_frame(fr);
-    if (vtu) vtu->write_frame(fr);
-    ++frames;
+    try {
+      if (xdmf) xdmf->write_frame(fr);
+      if (vtu) vtu->write_frame(fr);
+      ++frames;
+    } catch (const std::runtime_error& e) {
+      ++frame_errors;
+      log->error("frame at t = {:.6g} s not written: {}", solver.time(), e.what());
+    }
   };
 
   // The loop.
@@ -423,6 +428,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     summary["time_reached_s"] = solver.time();
     summary["time_step_final_s"] = solver.time_step();
     summary["frames"] = frames;
+    summary["frame_write_errors"] = frame_errors;
     summary["energy_balance_error"] = en.error();
     summary["energy_balance_error_max"] = max_error;
     summary["kinetic_energy_J"] = en.kinetic;
