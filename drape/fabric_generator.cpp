@@ -122,16 +122,9 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       }
       const auto tow = static_cast<std::int32_t>(fm.n_tows++);
       fm.ply_of_tow.push_back(static_cast<int>(q));
-      for (int kz = 0; kz < nt; ++kz)
-        for (int m = 0; m < nw; ++m)
-          for (int i = 0; i < nl; ++i) {
-            // a x b = +z: (i, m) counter-clockwise seen from +z, VTK hexahedron order.
-            mesh.hexes.push_back({node(i, m, kz), node(i + 1, m, kz), node(i + 1, m + 1, kz), node(i, m + 1, kz),
-                                  node(i, m, kz + 1), node(i + 1, m, kz + 1), node(i + 1, m + 1, kz + 1),
-                                  node(i, m + 1, kz + 1)});
-            mesh.hex_part.push_back(part);
-            fm.tow_of_hex.push_back(tow);
-          }
+      // The tow's node grid (i along, m across, kz through) is a structured grid: a x b = +z.
+      append_grid_hexes(mesh, part, base, {nl, nw, nt});
+      fm.tow_of_hex.resize(fm.tow_of_hex.size() + static_cast<std::size_t>(nl * nw * nt), tow);
     }
   }
 

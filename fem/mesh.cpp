@@ -168,6 +168,12 @@ std::vector<std::int32_t> add_hex_block(Mesh& mesh, int part, const std::array<d
         mesh.coords.push_back(origin[1] + size[1] * j / ny);
         mesh.coords.push_back(origin[2] + size[2] * k / nz);
       }
+  append_grid_hexes(mesh, part, first, {nx, ny, nz});
+  return ids;
+}
+
+void append_grid_hexes(Mesh& mesh, int part, std::int32_t first, const std::array<int, 3>& cells) {
+  const int nx = cells[0], ny = cells[1], nz = cells[2];
   auto id = [&](int i, int j, int k) { return first + i + (nx + 1) * (j + (ny + 1) * k); };
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
@@ -177,7 +183,6 @@ std::vector<std::int32_t> add_hex_block(Mesh& mesh, int part, const std::array<d
                               id(i, j + 1, k + 1)});
         mesh.hex_part.push_back(part);
       }
-  return ids;
 }
 
 }  // namespace ncfsim::fem

@@ -37,6 +37,11 @@ struct Mesh {
 /// Returns the new-from-old node map (new_index = map[old_index]).
 std::vector<std::int32_t> renumber_for_locality(Mesh& mesh);
 
+/// Hexahedra of a structured node grid already in the mesh: node (i, j, k) is
+/// first + i + (nx + 1) (j + (ny + 1) k), cells = {nx, ny, nz}; (i, j) counter-clockwise seen from
+/// +k (VTK order, positive volume when the grid axes are right-handed).
+void append_grid_hexes(Mesh& mesh, int part, std::int32_t first, const std::array<int, 3>& cells);
+
 /// A structured block of hexahedra (origin, edge lengths, divisions), appended to `mesh`.
 /// Returns the node indices of the block in i-fastest order [(nx+1)*(ny+1)*(nz+1)].
 std::vector<std::int32_t> add_hex_block(Mesh& mesh, int part, const std::array<double, 3>& origin,

@@ -13,6 +13,34 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
+
+// Sums over the DOFs of F.v^{n-1/2}, F.v^{n+1/2} per force kind and m v^{n-1/2} v^{n+1/2}.
+struct NodeUpdateSums {
+  double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
+};
+
+// v^{n+1/2} of every DOF as if free, branch-free so that it vectorises; with kMoveX the positions
+// move on to x^{n+1} in the same pass (one sweep over the nodal arrays when no callback needs x^n).
+template <bool kMoveX>
+NodeUpdateSums free_node_update(std::size_t nd, double alpha, double dt_mid, double dt_new, const double* inv_m,
+                                const double* mm, const double* fi, const double* fe, const double* fcon,
+                                double* vel, double* fdamp, double* x) {
+  double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
+#pragma omp simd reduction(+ : ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke)
+  for (std::size_t d = 0; d < nd; ++d) {
+    const double vo = vel[d], m = mm[d];
+    const double fd = -alpha * m * vo;
+    const double vn = vo + dt_mid * (fi[d] + fe[d] + fcon[d] + fd) * inv_m[d];
+    vel[d] = vn;
+    fdamp[d] = fd;
+    if constexpr (kMoveX) x[d] += dt_new * vn;
+    ext_old += fe[d] * vo, ext_new += fe[d] * vn;
+    damp_old += fd * vo, damp_new += fd * vn;
+    con_old += fcon[d] * vo, con_new += fcon[d] * vn;
+    ke += m * vo * vn;
+  }
+  return {ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke};
+}
 }  // namespace
 
 ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
@@ -376,7 +404,6 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
 
   // v^{n+1/2}; works of each force kind over the increments around t^n.
   const double dt_mid = 0.5 * (dt_prev_ + dt_new);
-  double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
   // Without a callback the position update joins this loop (one pass over the nodal arrays).
   double* xfused = at_tn ? nullptr : X.data();
   const double* inv_m = inv_mass_.data();
@@ -390,34 +417,9 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   // without branches (it vectorises), then those DOFs are corrected.
   for (std::size_t k = 0; k < constrained_.size(); ++k) constrained_vo_[k] = vel[constrained_[k]];
   const double dtp = dt_prev_;
-  if (xfused) {
-#pragma omp simd reduction(+ : ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke)
-    for (std::size_t d = 0; d < nd; ++d) {
-      const double vo = vel[d], m = mm[d];
-      const double fd = -alpha * m * vo;
-      const double vn = vo + dt_mid * (fi[d] + fe[d] + fcon[d] + fd) * inv_m[d];
-      vel[d] = vn;
-      fdamp[d] = fd;
-      xfused[d] += dt_new * vn;
-      ext_old += fe[d] * vo, ext_new += fe[d] * vn;
-      damp_old += fd * vo, damp_new += fd * vn;
-      con_old += fcon[d] * vo, con_new += fcon[d] * vn;
-      ke += m * vo * vn;
-    }
-  } else {
-#pragma omp simd reduction(+ : ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke)
-    for (std::size_t d = 0; d < nd; ++d) {
-      const double vo = vel[d], m = mm[d];
-      const double fd = -alpha * m * vo;
-      const double vn = vo + dt_mid * (fi[d] + fe[d] + fcon[d] + fd) * inv_m[d];
-      vel[d] = vn;
-      fdamp[d] = fd;
-      ext_old += fe[d] * vo, ext_new += fe[d] * vn;
-      damp_old += fd * vo, damp_new += fd * vn;
-      con_old += fcon[d] * vo, con_new += fcon[d] * vn;
-      ke += m * vo * vn;
-    }
-  }
+  auto [ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke] =
+      xfused ? free_node_update<true>(nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused)
+             : free_node_update<false>(nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, nullptr);
   // Works over the increments du_old = dt_prev v^{n-1/2}, du_new = dt_new v^{n+1/2}; kinetic energy
   // in product form: with the trapezoidal works, 1/2 v^{n-1/2} M v^{n+1/2} makes the discrete
   // energy balance of central differences exact for conservative forces.
