@@ -116,8 +116,8 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
   cand_start_.assign(n_node + 1, 0);
   cand_seg_.clear();
   const std::size_t n_blocks = (n_seg + kFrameLanes - 1) / kFrameLanes;
-  frame_stamp_.assign(n_blocks, -1);
   frame_.resize(n_blocks * kFrameLanes);
+  n_frame_blocks_ = n_blocks;
   box_lo_.resize(3 * active_seg_.size());
   box_hi_.resize(3 * active_seg_.size());
   pair_force_.assign(cfg_.pairs.size(), V3{});
@@ -155,13 +155,15 @@ void PenaltyContact::compute_frames(const double* x, std::size_t blk) {
 bool PenaltyContact::closer_adjacent_face(const double* x, const std::int32_t* adj,
                                           const double* fn, int nf, double px, double py, double pz,
                                           double pen, bool in_contact) {
-  const std::int64_t cycle = stats_.n_cycles;
   const double thick = cfg_.thickness;
   for (int a = 0; a < 4 && adj[a] >= 0; ++a) {
     const auto q = static_cast<std::size_t>(adj[a]);
-    const auto blk = q / kFrameLanes;
-    if (frame_stamp_[blk] != cycle) compute_frames(x, blk), frame_stamp_[blk] = cycle;
-    const SegmentFrame& F = frame_[q];
+    // Made here: the test runs only on a hit of a segment with outer neighbours in its own
+    // hexahedron that beats the node's best so far, a small share of the candidates.
+    double corners[4][3];
+    gather_segment(x, &surf_.seg_nodes[4 * q], corners);
+    SegmentFrame F;
+    segment_frame(corners, depth_[q], F);
     bool faces = false;
     for (int j = 0; j < nf; ++j)
       faces = faces || fn[3 * j] * F.n[0] + fn[3 * j + 1] * F.n[1] + fn[3 * j + 2] * F.n[2] <
@@ -184,10 +186,7 @@ void PenaltyContact::sort_segments(const double* x) {
   const std::size_t ng = n_groups_, n_node = surf_.n_nodes(), n_act = active_seg_.size();
   const double margin = margin_;
   // Frames of all segments, grown boxes of the active ones.
-  for (std::size_t blk = 0; blk < frame_stamp_.size(); ++blk) {
-    compute_frames(x, blk);
-    frame_stamp_[blk] = stats_.n_cycles;
-  }
+  for (std::size_t blk = 0; blk < n_frame_blocks_; ++blk) compute_frames(x, blk);
   for (std::size_t a = 0; a < n_act; ++a) {
     const auto s = static_cast<std::size_t>(active_seg_[a]);
     double p[4][3];
@@ -292,6 +291,34 @@ void PenaltyContact::sort_segments(const double* x) {
     }
   }
   cand_start_[n_node] = static_cast<std::int32_t>(cand_seg_.size());
+
+  // The same candidates segment by segment (a counting sort, stable: nodes in increasing order),
+  // for the cycle's narrow phase, which walks the segments once.
+  {
+    const std::size_t n_seg = surf_.n_segments();
+    seg_count_.assign(n_seg + 1, 0);
+    for (auto q : cand_seg_) ++seg_count_[static_cast<std::size_t>(q) + 1];
+    used_seg_.clear();
+    used_cand_start_.clear();
+    for (std::size_t q = 0; q < n_seg; ++q)
+      if (seg_count_[q + 1] > 0) used_seg_.push_back(static_cast<std::int32_t>(q));
+    for (std::size_t q = 0; q < n_seg; ++q) seg_count_[q + 1] += seg_count_[q];
+    for (auto q : used_seg_) used_cand_start_.push_back(seg_count_[static_cast<std::size_t>(q)]);
+    used_cand_start_.push_back(seg_count_[n_seg]);
+    const std::size_t n_cand = cand_seg_.size();
+    ucand_node_.resize(n_cand);
+    ucand_facet_.resize(n_cand);
+    for (std::size_t e = 0; e < n_node; ++e)
+      for (std::int32_t c = cand_start_[e]; c < cand_start_[e + 1]; ++c) {
+        const auto q = static_cast<std::size_t>(cand_seg_[static_cast<std::size_t>(c)]);
+        const auto r = static_cast<std::size_t>(seg_count_[q]++);
+        ucand_node_[r] = static_cast<std::int32_t>(e);
+        ucand_facet_[r] = facet_start_[e] + cand_facet_[static_cast<std::size_t>(c)];
+      }
+    best_seg_.resize(static_cast<std::size_t>(facet_start_[n_node]));
+    best_gap_.resize(best_seg_.size());
+    best_.resize(best_seg_.size());
+  }
   ++stats_.n_sorts;
   stats_.n_candidates = static_cast<std::int64_t>(cand_seg_.size());
   stats_.sort_seconds +=
@@ -324,9 +351,11 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   }
   const auto t1 = Clock::now();
 
-  // 2. Narrow phase: each node's contact per facet (segment frames are made on first use),
-  // gathered into batches whose forces the branch-free kernel computes (contact_forces), then
-  // scattered.
+  // 2. Narrow phase, segment by segment: the frames of kFrameLanes segments that have
+  // candidates are made in SIMD lanes and each node listed under them is projected while the
+  // frame is in registers; a facet keeps its best hit (largest gap). Then, node by node, the
+  // facets' contacts go in batches through the branch-free force kernel (contact_forces) and
+  // their forces are scattered.
   for (auto& F : pair_force_) F = {};
   const double thick = cfg_.thickness, lim = 1.0 + 2.0 * cfg_.edge_tolerance;
   const double kscale = cfg_.penalty_scale * inv_dt0_sq_;
@@ -336,18 +365,66 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   const std::uint8_t* n_facets = n_facets_.data();
   const std::int32_t* facet_start = facet_start_.data();
   const double* m_node = node_mass_.data();
-  const std::int32_t* start = cand_start_.data();
-  const std::int32_t* cand = cand_seg_.data();
-  const std::uint8_t* cand_facet = cand_facet_.data();
   const std::int32_t* sn = surf_.seg_nodes.data();
   const std::int32_t* sg = surf_.seg_group.data();
-  const SegmentFrame* fr = frame_.data();
   const std::int32_t* seg_adj = seg_adjacent_.data();
-  std::int64_t* stamp = frame_stamp_.data();
-  const std::int64_t cycle = stats_.n_cycles;
   const double* mu_of = mu_of_.data();
   double* tang = tangential_.data();
   std::int32_t* last = last_seg_.data();
+  std::int32_t* best_seg = best_seg_.data();
+  double* best_gap = best_gap_.data();
+  BestHit* best = best_.data();
+  const std::size_t n_facet_all = best_seg_.size();
+  std::fill_n(best_seg, n_facet_all, -1);
+  std::fill_n(best_gap, n_facet_all, -std::numeric_limits<double>::max());
+  {
+    const std::size_t n_used = used_seg_.size();
+    const std::int32_t* used = used_seg_.data();
+    const std::int32_t* ustart = used_cand_start_.data();
+    const std::int32_t* unode = ucand_node_.data();
+    const std::int32_t* ufacet = ucand_facet_.data();
+    alignas(64) double p[4][3][kFrameLanes];
+    alignas(64) double depth[kFrameLanes];
+    SegmentFrameBlock fb;
+    for (std::size_t u0 = 0; u0 < n_used; u0 += kFrameLanes) {
+      const std::size_t n_lanes = std::min<std::size_t>(kFrameLanes, n_used - u0);
+      for (std::size_t l = 0; l < kFrameLanes; ++l) {
+        const auto q = static_cast<std::size_t>(used[std::min(u0 + l, n_used - 1)]);
+        for (int c = 0; c < 4; ++c) {
+          const double* xc = x + 3 * static_cast<std::size_t>(sn[4 * q + static_cast<std::size_t>(c)]);
+          p[c][0][l] = xc[0], p[c][1][l] = xc[1], p[c][2][l] = xc[2];
+        }
+        depth[l] = depth_[q];
+      }
+      segment_frames(p, depth, fb);
+      for (std::size_t l = 0; l < n_lanes; ++l) {
+        const std::int32_t s = used[u0 + l];
+        const std::int32_t* adj = seg_adj + 4 * static_cast<std::size_t>(s);
+        const double d = fb.depth[l];
+        const auto li = static_cast<int>(l);
+        for (std::int32_t c = ustart[u0 + l]; c < ustart[u0 + l + 1]; ++c) {
+          const auto e = static_cast<std::size_t>(unode[c]);
+          const auto fi = static_cast<std::size_t>(ufacet[c]);
+          const double* xp = x + 3 * static_cast<std::size_t>(node[e]);
+          const SegmentProjection pr = project_on_segment(fb, li, xp[0], xp[1], xp[2]);
+          bool hit = (std::abs(pr.xi) <= lim) & (std::abs(pr.eta) <= lim) & (pr.gap < thick) &
+                     (pr.gap > -d) & (pr.gap > best_gap[fi]);
+          // Closest feature (see closer_adjacent_face): a tow-end node lying on a thin tow's
+          // top face also projects onto the tow's side face (at its top edge), up to half the
+          // tow width 'deep', and its end facet faces that side: the top face is the contact,
+          // the side is not.
+          if (hit && adj[0] >= 0)
+            hit = !closer_adjacent_face(x, adj, &facet_[3 * kMaxFacets * e], n_facets[e], xp[0],
+                                        xp[1], xp[2], thick - pr.gap, last[fi] == s);
+          if (hit) {
+            best_seg[fi] = s;
+            best_gap[fi] = pr.gap;
+            best[fi] = {pr.xi, pr.eta, {fb.n[0][l], fb.n[1][l], fb.n[2][l]}};
+          }
+        }
+      }
+    }
+  }
   ContactBatch& B = batch_;
   B.n = 0;
   std::int64_t n_active = 0;
@@ -374,62 +451,26 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     B.n = 0;
   };
   for (std::size_t e = 0; e < n_node; ++e) {
-    const std::int32_t b = start[e], end = start[e + 1];
     const int nf = n_facets[e];
-    double* ft_node = tang + 3 * static_cast<std::size_t>(facet_start[e]);
-    std::int32_t* last_node = last + facet_start[e];
-    if (b == end) {
-      for (int j = 0; j < 3 * nf; ++j) ft_node[j] = 0;
-      for (int j = 0; j < nf; ++j) last_node[j] = -1;
-      continue;
-    }
+    const auto f0 = static_cast<std::size_t>(facet_start[e]);
     const auto i = static_cast<std::size_t>(node[e]);
-    const double px = x[3 * i], py = x[3 * i + 1], pz = x[3 * i + 2];
-    const double* fn_node = &facet_[3 * kMaxFacets * e];
-    std::int32_t best[kMaxFacets] = {-1, -1, -1};
-    double best_gap[kMaxFacets], bxi[kMaxFacets] = {}, beta[kMaxFacets] = {};
-    for (double& g : best_gap) g = -std::numeric_limits<double>::max();
-    for (std::int32_t c = b; c < end; ++c) {
-      const std::int32_t s = cand[c];
-      const int j = cand_facet[c];
-      // Frames are made on first use in a cycle, a block at a time, while the node loop is
-      // nearby: they are read from cache right after.
-      const auto blk = static_cast<std::size_t>(s) / kFrameLanes;
-      if (stamp[blk] != cycle) compute_frames(x, blk), stamp[blk] = cycle;
-      const SegmentFrame& F = fr[s];
-      const SegmentProjection pr = project_on_segment(F, px, py, pz);
-      // Branch-free test: candidates pass or fail unpredictably.
-      bool hit = (std::abs(pr.xi) <= lim) & (std::abs(pr.eta) <= lim) & (pr.gap < thick) &
-                 (pr.gap > -F.depth) & (pr.gap > best_gap[j]);
-      // Closest feature (see closer_adjacent_face): a tow-end node lying on a thin tow's top
-      // face also projects onto the tow's side face (at its top edge), up to half the tow width
-      // 'deep', and its end facet faces that side: the top face is the contact, the side is not.
-      const std::int32_t* adj = seg_adj + 4 * static_cast<std::size_t>(s);
-      if (hit && adj[0] >= 0)
-        hit = !closer_adjacent_face(x, adj, fn_node, nf, px, py, pz, thick - pr.gap,
-                                    last_node[j] == s);
-      best[j] = hit ? s : best[j];
-      best_gap[j] = hit ? pr.gap : best_gap[j];
-      bxi[j] = hit ? pr.xi : bxi[j];
-      beta[j] = hit ? pr.eta : beta[j];
-    }
     const double m_s = m_node[i];
     const double vsx = v[3 * i], vsy = v[3 * i + 1], vsz = v[3 * i + 2];
     const std::size_t row = static_cast<std::size_t>(group[e]) * ng;
-    for (int j = 0; j < nf; ++j) {
-      double* ft = ft_node + 3 * j;
-      last_node[j] = best[j];
-      if (best[j] < 0) {
+    for (std::size_t fi = f0; fi < f0 + static_cast<std::size_t>(nf); ++fi) {
+      double* ft = tang + 3 * fi;
+      last[fi] = best_seg[fi];
+      if (best_seg[fi] < 0) {
         ft[0] = ft[1] = ft[2] = 0;
         continue;
       }
       ++n_active;
-      const auto s = static_cast<std::size_t>(best[j]);
-      const SegmentFrame& F = fr[s];
+      const auto s = static_cast<std::size_t>(best_seg[fi]);
+      const BestHit& F = best[fi];
       const std::int32_t* corner = sn + 4 * s;
       const int l = B.n++;
       double N[4];
-      segment_shape(bxi[j], beta[j], N);
+      segment_shape(F.xi, F.eta, N);
       double m_m = 0, vmx = 0, vmy = 0, vmz = 0;
       for (int a = 0; a < 4; ++a) {
         const auto q = 3 * static_cast<std::size_t>(corner[a]);
@@ -437,7 +478,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
         vmx += N[a] * v[q], vmy += N[a] * v[q + 1], vmz += N[a] * v[q + 2];
         B.N[a][l] = N[a];
       }
-      const double pen = thick - best_gap[j];
+      const double pen = thick - best_gap[fi];
       if (pen > max_pen) max_pen = pen, max_pen_node = static_cast<std::int32_t>(i);
       const std::size_t cell = row + static_cast<std::size_t>(sg[s]);
       B.pen[l] = pen;
@@ -448,7 +489,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
       B.tx[l] = ft[0], B.ty[l] = ft[1], B.tz[l] = ft[2];
       B.slave[l] = static_cast<std::int32_t>(i);
       B.seg[l] = static_cast<std::int32_t>(s);
-      B.state[l] = facet_start[e] + j;
+      B.state[l] = static_cast<std::int32_t>(fi);
       B.cell[l] = static_cast<std::int32_t>(cell);
       if (B.n == kContactBatch) flush();
     }

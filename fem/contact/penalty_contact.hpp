@@ -12,15 +12,18 @@
 //     the directions of its own surface around it (adjacent segment normals clustered within
 //     45 deg): one on a flat or gently curved surface, two on an edge, three at a corner. A
 //     candidate faces facet j when n_facet_j . n_segment < -0.5 (opposed within 60 deg).
-//  2. A frame per candidate segment (centre, normal, dual tangents; SegmentFrame), made on its
-//     first use in the cycle, kFrameLanes segments at a time in SIMD lanes (SegmentFrameBlock).
-//  3. Narrow phase per surface node and facet: projection on each candidate; the facet's
-//     contact is the segment the node projects into (with edge_tolerance) with the largest gap
-//     below `thickness` and above -depth, and that passes the closest-feature test against the
-//     other faces of its hexahedron (closer_adjacent_face: a node on a thin tow's top face is not
-//     pushed out through the tow's side). One contact per facet: a node on the edge of one tow,
-//     pinched between the next tow's side and the ply above, is pushed by both; a node on a flat
-//     surface over a seam between two segments is pushed once.
+//  2. Narrow phase, segment by segment (the candidates are also kept grouped by segment): the
+//     frames (centre, normal, dual tangents; SegmentFrame) of kFrameLanes segments that have
+//     candidates are made in SIMD lanes, and every node listed under them is projected while
+//     the frames are in registers. Each cycle reads positions and the candidate lists only; no
+//     frame is stored, so nothing is fetched twice from memory.
+//  3. Per surface node and facet the contact is the segment the node projects into (with
+//     edge_tolerance) with the largest gap below `thickness` and above -depth, and that passes
+//     the closest-feature test against the other faces of its hexahedron (closer_adjacent_face:
+//     a node on a thin tow's top face is not pushed out through the tow's side). One contact per
+//     facet: a node on the edge of one tow, pinched between the next tow's side and the ply
+//     above, is pushed by both; a node on a flat surface over a seam between two segments is
+//     pushed once.
 //  4. Forces of the active contacts in batches (contact_forces, a branch-free SIMD kernel):
 //     normal k (thickness - gap) plus damping that never pulls, friction from the relative
 //     tangential velocity with an elastic spring per node facet; the force goes on the node and,
@@ -79,7 +82,7 @@ class PenaltyContact final : public ContactAlgorithm {
 
  private:
   void sort_segments(const double* x);                      // broad phase at positions x
-  void compute_frames(const double* x, std::size_t block);  // frames of one block at x
+  void compute_frames(const double* x, std::size_t block);  // frames of one block at x (sort)
   /// Closest-feature test of a contact of penetration pen on a segment, against the outer faces
   /// adjacent to it in the same hexahedron (adj[4], -1 padded) that are opposed to one of the
   /// node's nf facets (fn[nf][3]). True (not the contact) when, for such a face, the node at p
@@ -112,11 +115,23 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<std::int32_t> last_seg_;      // [n_facet] contact segment of each node facet in the
   std::vector<std::int32_t> last_seg_old_;  // last cycle, -1: none (and before the last sort)
   std::vector<double> node_mass_;          // [n_nodes] lumped nodal masses (fixed after set-up), kg
-  std::vector<std::int32_t> cand_start_;   // [n_snode + 1] CSR into cand_seg_
+  std::vector<std::int32_t> cand_start_;   // [n_snode + 1] CSR into cand_seg_ (at the sort)
   std::vector<std::int32_t> cand_seg_;     // candidate segments, node by node
   std::vector<std::uint8_t> cand_facet_;   // facet of the node each candidate faces
-  std::vector<std::int64_t> frame_stamp_;  // [n_blocks] cycle the block's frames were made in
-  std::vector<SegmentFrame> frame_;        // [n_blocks * kFrameLanes] (valid in used blocks)
+  // The candidates segment by segment (what the cycle reads): segments with candidates in
+  // increasing order, CSR into the surface node and the global facet index of each candidate.
+  std::vector<std::int32_t> used_seg_, used_cand_start_, ucand_node_, ucand_facet_;
+  std::vector<std::int32_t> seg_count_;  // [n_seg + 1] work array of the counting sort
+  /// Best hit of a node facet in the current cycle (with best_seg_ and best_gap_).
+  struct BestHit {
+    double xi, eta;  // local coordinates on the segment
+    double n[3];     // the segment's unit normal
+  };
+  std::vector<std::int32_t> best_seg_;  // [n_facet] -1: no contact this cycle
+  std::vector<double> best_gap_;        // [n_facet]
+  std::vector<BestHit> best_;           // [n_facet] valid where best_seg_ >= 0
+  std::size_t n_frame_blocks_ = 0;
+  std::vector<SegmentFrame> frame_;  // [n_blocks * kFrameLanes] all frames, made at the sort
   std::vector<double> box_lo_, box_hi_;    // [n_seg][3] grown segment boxes at the sort
   std::vector<double> facet_;              // [n_snode][kMaxFacets][3] facet normals at the sort
   std::vector<std::uint8_t> n_facets_;     // [n_snode]
