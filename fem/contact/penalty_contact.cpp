@@ -159,16 +159,23 @@ bool PenaltyContact::closer_adjacent_face(const double* x, const std::int32_t* a
   for (int a = 0; a < 4 && adj[a] >= 0; ++a) {
     const auto q = static_cast<std::size_t>(adj[a]);
     // Made here: the test runs only on a hit of a segment with outer neighbours in its own
-    // hexahedron that beats the node's best so far, a small share of the candidates.
+    // hexahedron that beats the node's best so far. The normal (along the cross product of the
+    // diagonals, as a1 x a2 = d1 x d2 / 8) decides first whether the face matters at all.
     double corners[4][3];
     gather_segment(x, &surf_.seg_nodes[4 * q], corners);
-    SegmentFrame F;
-    segment_frame(corners, depth_[q], F);
+    double d1[3], d2[3];
+    for (int k = 0; k < 3; ++k)
+      d1[k] = corners[2][k] - corners[0][k], d2[k] = corners[3][k] - corners[1][k];
+    const double m[3] = {d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2],
+                         d1[0] * d2[1] - d1[1] * d2[0]};
+    const double m_len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
     bool faces = false;
     for (int j = 0; j < nf; ++j)
-      faces = faces || fn[3 * j] * F.n[0] + fn[3 * j + 1] * F.n[1] + fn[3 * j + 2] * F.n[2] <
-                           kOpposedNormals;
+      faces = faces || fn[3 * j] * m[0] + fn[3 * j + 1] * m[1] + fn[3 * j + 2] * m[2] <
+                           kOpposedNormals * m_len;
     if (!faces) continue;
+    SegmentFrame F;
+    segment_frame(corners, depth_[q], F);
     // o: distance of the node in front of that face's plane (< 0: behind it); band: how far the
     // segment's edge tolerance reaches past the shared edge (the hexahedron's thickness normal
     // to that face times edge_tolerance).
