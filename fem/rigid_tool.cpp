@@ -214,12 +214,18 @@ void tool_contact_forces(RigidTool& tool, const double* x, const double* v, cons
       continue;
     }
     ++active;
-    const double k = tool.penalty_scale * mass[3 * i] * inv_dt2;
+    const double m = mass[3 * i];
+    const double k = tool.penalty_scale * m * inv_dt2;
     const double fn = -k * (gap - tool.thickness);
-    V3 F = fn * nrm;
+    const V3 vrel = V3::at(v + 3 * i) - tool.velocity;
+    const double vn = dot(vrel, nrm);  // > 0: separating
+    // c = 2 zeta sqrt(k m) = 2 zeta m sqrt(penalty_scale) / dt
+    const double c = 2.0 * tool.damping * m * std::sqrt(tool.penalty_scale) / dt;
+    const double f_normal = std::max(fn - c * vn, 0.0);
+    tool.friction_dissipation += (fn - f_normal) * vn * dt;
+    V3 F = f_normal * nrm;
     if (tool.friction > 0) {
-      const V3 vrel = V3::at(v + 3 * i) - tool.velocity;
-      const V3 vt = vrel - dot(vrel, nrm) * nrm;
+      const V3 vt = vrel - vn * nrm;
       V3 trial = *ft - dot(*ft, nrm) * nrm;
       trial -= (k * dt) * vt;
       const double cap = tool.friction * fn, mag = norm(trial);

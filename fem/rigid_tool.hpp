@@ -64,6 +64,11 @@ struct RigidTool {
   std::vector<std::int32_t> contact_nodes;  // slave nodes
   double friction = 0;        // Coulomb coefficient
   double penalty_scale = 0.1; // k = scale * m_node / dt^2: never lowers the stable step
+  /// Viscous damping of the normal penalty spring, share of critical 2 sqrt(k m), [0, 1]: damps
+  /// contact chatter and friction-excited flutter of soft bodies sliding on the tool (a sled
+  /// pulled at its top pitched into a growing normal-force oscillation without it); never pulls.
+  /// Its work is reported with the friction dissipation.
+  double damping = 0.1;
   double thickness = 0;       // contact offset (shell thickness / 2 or clearance)
 
   // State
@@ -71,7 +76,7 @@ struct RigidTool {
   V3 velocity;                      // tool velocity over the current half step
   V3 force;                         // resultant contact force exerted BY the nodes ON the tool
   std::vector<double> tangential;   // [3*n_contact_nodes] elastic friction forces
-  double friction_dissipation = 0;  // J
+  double friction_dissipation = 0;  // J, friction and normal damping
   std::int64_t n_active = 0;
 };
 

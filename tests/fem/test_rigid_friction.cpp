@@ -91,3 +91,48 @@ TEST(RigidFriction, BelowMuNormalForceTheBlockSticks) {
   const auto& tool = solver.model().tools[0];
   EXPECT_TRUE(test::near_rel(tool.force.x, 0.6 * kMu * kN, 0.02)) << "static friction carries the push";
 }
+
+// Normal damping of the tool's penalty spring: a block dropped on the plane keeps nearly all of
+// its kinetic energy through the bounce without it (the penalty spring is conservative; a little
+// stays in the block as strain energy of its vibration) and clearly less with it; in both cases
+// the energy balance closes because the damping work is counted with the contact dissipation.
+namespace {
+struct Bounce {
+  double kinetic_ratio, dissipated_ratio, balance_error;
+};
+Bounce drop_on_plane(double damping) {
+  fem::Model model;
+  test::add_elastic_block(model, "block", {0, 0, 1e-4}, {kSize, kSize, kSize}, {2, 2, 2}, 2000, 1e8,
+                          0.3);
+  fem::RigidTool plane;
+  plane.name = "table";
+  plane.surface.shape = fem::ToolShape::Plane;
+  plane.surface.point = {0, 0, 0};
+  plane.surface.axis = {0, 0, 1};
+  plane.contact_nodes = test::nodes_at(model.mesh, 2, 1e-4);
+  plane.damping = damping;
+  model.tools.push_back(plane);
+  fem::InitialVelocity drop;
+  for (std::size_t i = 0; i < model.mesh.n_nodes(); ++i)
+    drop.nodes.push_back(static_cast<std::int32_t>(i));
+  drop.velocity = {0, 0, -1.0};
+  model.initial_velocities.push_back(drop);
+  model.time.end_time = 2e-3;  // the bounce lasts a few element transit times (~0.1 ms)
+  fem::ExplicitSolver solver(model);
+  while (solver.time() < model.time.end_time) solver.step();
+  const auto& e = solver.energy();
+  const double ke0 = 0.5 * 2000 * kSize * kSize * kSize * 1.0 * 1.0;
+  return {e.kinetic / ke0, solver.model().tools[0].friction_dissipation / ke0, e.error()};
+}
+}  // namespace
+
+TEST(RigidContactDamping, DampingTakesEnergyFromTheBounceAndItsWorkIsCounted) {
+  const Bounce elastic = drop_on_plane(0.0);
+  const Bounce damped = drop_on_plane(0.5);
+  EXPECT_GT(elastic.kinetic_ratio, 0.8) << "conservative penalty: a nearly elastic bounce";
+  EXPECT_NEAR(elastic.dissipated_ratio, 0.0, 1e-12);
+  EXPECT_LT(damped.kinetic_ratio, 0.8 * elastic.kinetic_ratio) << "damping takes energy";
+  EXPECT_GT(damped.dissipated_ratio, 0.1);
+  EXPECT_LT(elastic.balance_error, 0.01);
+  EXPECT_LT(damped.balance_error, 0.01);
+}

@@ -257,6 +257,7 @@ void read_tools(const TableReader& root, EngineCase& ec, const std::string& file
     }
     tool.friction = t.number("friction", 0.0, Range::non_negative());
     tool.penalty_scale = t.number("penalty_scale", 0.1, Range::open_closed(0, 1.0));
+    tool.damping = t.number("damping", 0.1, Range::closed(0, 1.0));
     tool.thickness = t.number("thickness", 0.0, Range::non_negative());
     tool.contact_nodes = select_nodes(t, "contact_nodes", ec.model.mesh);
     ec.model.tools.push_back(std::move(tool));
