@@ -96,6 +96,8 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
   }
   x_sorted_.assign(3 * n_node, 0.0);
   tangential_.clear();
+  offset_.clear();
+  elastic_.clear();
   last_seg_.clear();
   facet_start_.assign(n_node + 1, 0);
   node_mass_.resize(setup.mesh->n_nodes());
@@ -211,6 +213,8 @@ void PenaltyContact::sort_segments(const double* x) {
   // the facet numbering, and with it the friction state, is stable from one sort to the next).
   facet_start_old_.swap(facet_start_);
   tangential_old_.swap(tangential_);
+  offset_old_.swap(offset_);
+  elastic_old_.swap(elastic_);
   last_seg_old_.swap(last_seg_);
   facet_start_.resize(n_node + 1);
   facet_start_[0] = 0;
@@ -244,6 +248,8 @@ void PenaltyContact::sort_segments(const double* x) {
   // Friction state and last contact segment carried over facet by facet.
   tangential_.assign(3 * static_cast<std::size_t>(facet_start_[n_node]), 0.0);
   last_seg_.assign(static_cast<std::size_t>(facet_start_[n_node]), -1);
+  offset_.assign(static_cast<std::size_t>(facet_start_[n_node]), 0.0);
+  elastic_.assign(offset_.size(), 0.0);
   if (!last_seg_old_.empty()) {
     for (std::size_t e = 0; e < n_node; ++e) {
       const auto f_new = static_cast<std::size_t>(facet_start_[e]);
@@ -252,7 +258,11 @@ void PenaltyContact::sort_segments(const double* x) {
           facet_start_old_[e + 1] - facet_start_old_[e], facet_start_[e + 1] - facet_start_[e]));
       for (std::size_t k = 0; k < 3 * n_keep; ++k)
         tangential_[3 * f_new + k] = tangential_old_[3 * f_old + k];
-      for (std::size_t k = 0; k < n_keep; ++k) last_seg_[f_new + k] = last_seg_old_[f_old + k];
+      for (std::size_t k = 0; k < n_keep; ++k) {
+        last_seg_[f_new + k] = last_seg_old_[f_old + k];
+        offset_[f_new + k] = offset_old_[f_old + k];
+        elastic_[f_new + k] = elastic_old_[f_old + k];
+      }
     }
   }
 
@@ -377,6 +387,8 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   const std::int32_t* seg_adj = seg_adjacent_.data();
   const double* mu_of = mu_of_.data();
   double* tang = tangential_.data();
+  double* offset = offset_.data();
+  double* elastic = elastic_.data();
   std::int32_t* last = last_seg_.data();
   std::int32_t* best_seg = best_seg_.data();
   double* best_gap = best_gap_.data();
@@ -466,9 +478,11 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     const std::size_t row = static_cast<std::size_t>(group[e]) * ng;
     for (std::size_t fi = f0; fi < f0 + static_cast<std::size_t>(nf); ++fi) {
       double* ft = tang + 3 * fi;
+      const std::int32_t was = last[fi];
       last[fi] = best_seg[fi];
       if (best_seg[fi] < 0) {
         ft[0] = ft[1] = ft[2] = 0;
+        offset[fi] = 0, elastic[fi] = 0;
         continue;
       }
       ++n_active;
@@ -485,8 +499,20 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
         vmx += N[a] * v[q], vmy += N[a] * v[q + 1], vmz += N[a] * v[q + 2];
         B.N[a][l] = N[a];
       }
-      const double pen = thick - best_gap[fi];
-      if (pen > max_pen) max_pen = pen, max_pen_node = static_cast<std::int32_t>(i);
+      // The spring acts on the penetration past an offset, so that the force never jumps: a node
+      // found already behind the surface (it came round a tow edge, or through a seam between
+      // tows) starts from zero force, and at a switch to another segment the elastic part of
+      // the penetration carries over. The offset only ever shrinks while the contact lasts (the
+      // node withdrawing takes it with it), so the law can lose energy but never create it.
+      const double pen_geo = thick - best_gap[fi];
+      double off = was < 0 ? pen_geo
+                   : was != best_seg[fi] ? std::max(pen_geo - elastic[fi], 0.0)
+                                         : std::min(offset[fi], pen_geo);
+      off = std::max(off, 0.0);
+      offset[fi] = off;
+      const double pen = pen_geo - off;
+      elastic[fi] = pen;
+      if (pen_geo > max_pen) max_pen = pen_geo, max_pen_node = static_cast<std::int32_t>(i);
       const std::size_t cell = row + static_cast<std::size_t>(sg[s]);
       B.pen[l] = pen;
       B.nx[l] = F.n[0], B.ny[l] = F.n[1], B.nz[l] = F.n[2];

@@ -110,6 +110,9 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<double> x_sorted_;           // [n_snode][3] positions at the last sort
   std::vector<double> tangential_;         // [n_facet][3] elastic friction force per node facet, N
   std::vector<std::int32_t> facet_start_;  // [n_snode + 1] first facet of each surface node
+  std::vector<double> offset_;   // [n_facet] penetration offset of the contact (no force jump), m
+  std::vector<double> elastic_;  // [n_facet] penetration past the offset in the last cycle, m
+  std::vector<double> offset_old_, elastic_old_;  // before the last sort (carried over)
   std::vector<double> tangential_old_;     // the two above before the last sort (carried over)
   std::vector<std::int32_t> facet_start_old_;
   std::vector<std::int32_t> last_seg_;      // [n_facet] contact segment of each node facet in the
