@@ -70,13 +70,50 @@ void TowMaterial::update_stress(const fem::MaterialBatch& b) const {
       E[k * s + e] += de[k * t + e];
       Ev[k] = E[k * s + e];
     }
-    for (int i = 0; i < 3; ++i)
-      sig[i * s + e] = C[6 * i] * Ev[0] + C[6 * i + 1] * Ev[1] + C[6 * i + 2] * Ev[2];
-    sig[s + e] += compaction_stress(Ev[1]);
-    sig[2 * s + e] += compaction_stress(Ev[2]);
-    sig[3 * s + e] = C[21] * Ev[3];
-    sig[4 * s + e] = C[28] * Ev[4];
-    sig[5 * s + e] = C[35] * Ev[5];
+    double S[6];
+    for (int i = 0; i < 3; ++i) S[i] = C[6 * i] * Ev[0] + C[6 * i + 1] * Ev[1] + C[6 * i + 2] * Ev[2];
+    S[3] = C[21] * Ev[3];
+    S[4] = C[28] * Ev[4];
+    S[5] = C[35] * Ev[5];
+    add_compaction_stress(Ev, S);
+    for (int k = 0; k < 6; ++k) sig[k * s + e] = S[k];
+  }
+}
+
+CompactionMeasure TowMaterial::compaction_measure(const double* Ev) {
+  // C = I + 2E (Voigt 11 22 33 12 23 13, engineering shears): C12 = gamma12 etc.
+  const double C11 = 1 + 2 * Ev[0], C22 = 1 + 2 * Ev[1], C33 = 1 + 2 * Ev[2];
+  const double C12 = Ev[3], C23 = Ev[4], C13 = Ev[5];
+  // Adjugate of C (symmetric); C^-1 = adj / det.
+  const double A11 = C22 * C33 - C23 * C23, A22 = C11 * C33 - C13 * C13, A33 = C11 * C22 - C12 * C12;
+  const double A12 = C13 * C23 - C12 * C33, A13 = C12 * C23 - C13 * C22, A23 = C12 * C13 - C11 * C23;
+  const double det = C11 * A11 + C12 * A12 + C13 * A13;
+  CompactionMeasure m;
+  // The spacing of the material planes X2 = const (they hold the fibres and the thickness
+  // direction) is lambda_2 = 1 / sqrt((C^-1)_22): E2 = (lambda_2^2 - 1) / 2; dE2/dE = m2 (x) m2
+  // with m2 = C^-1 e2 / (C^-1)_22. Likewise for the planes X3 = const.
+  m.E2 = 0.5 * (det / A22 - 1);
+  m.E3 = 0.5 * (det / A33 - 1);
+  m.m2 = {A12 / A22, 1.0, A23 / A22};
+  m.m3 = {A13 / A33, A23 / A33, 1.0};
+  return m;
+}
+
+void TowMaterial::add_compaction_stress(const double* Ev, double* S) const {
+  if (c_.compaction_modulus == 0) return;
+  if (Ev[1] >= 0 && Ev[2] >= 0 && (!c_.compaction_of_fibre_sheets || (Ev[3] == 0 && Ev[4] == 0 && Ev[5] == 0))) return;
+  const CompactionMeasure cm =
+      c_.compaction_of_fibre_sheets ? compaction_measure(Ev) : CompactionMeasure{Ev[1], Ev[2], {0, 1, 0}, {0, 0, 1}};
+  for (int d = 0; d < 2; ++d) {
+    const double sc = compaction_stress(d == 0 ? cm.E2 : cm.E3);
+    if (sc == 0) continue;
+    const auto& m = d == 0 ? cm.m2 : cm.m3;
+    S[0] += sc * m[0] * m[0];
+    S[1] += sc * m[1] * m[1];
+    S[2] += sc * m[2] * m[2];
+    S[3] += sc * m[0] * m[1];
+    S[4] += sc * m[1] * m[2];
+    S[5] += sc * m[0] * m[2];
   }
 }
 

@@ -56,6 +56,13 @@ struct PictureFrame {
   double shear_rate = 0;   // rad/s
   double ramp_time = 0;    // s
   double arm_length = 0;   // m, frame side (pin to pin), for the frame force
+  // Arms as walls (optional): the arms are rigid bars in the plane of the fabric; the nodes of
+  // walls[0] bear on the two arms along arm1 (the lines eta = 0 and eta = arm_length), those of
+  // walls[1] on the two along arm2 (xi = 0, xi = arm_length). The walls are strips through the
+  // arms (pin to pin) normal to the frame plane, frictionless, node-to-wall penalty k = scale m / dt^2
+  // (never lowers the stable step); they move with the frame (their work is the frame's).
+  std::array<std::vector<std::int32_t>, 2> walls;
+  double wall_penalty_scale = 0.1;
 };
 
 /// Frame shear angle (rad) and its rate at time t.

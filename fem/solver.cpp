@@ -41,6 +41,12 @@ NodeUpdateSums free_node_update(std::size_t nd, double alpha, double dt_mid, dou
   }
   return {ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke};
 }
+// Velocity of the frame's material point (xi, eta) at time t (d/dt of corner + xi u1 + eta u2).
+V3 frame_point_velocity(const PictureFrame& pf, double t, double xi, double eta) {
+  const double g = picture_frame_angle(pf, t), gd = 0.5 * picture_frame_rate(pf, t);
+  const double cs = std::cos(0.5 * g), sn = std::sin(0.5 * g);
+  return gd * (xi * (-sn * pf.arm1 + cs * pf.arm2) + eta * (cs * pf.arm1 - sn * pf.arm2));
+}
 }  // namespace
 
 ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
@@ -123,6 +129,18 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   }
   frame_c1_.resize(model_.picture_frames.size());
   frame_c2_.resize(model_.picture_frames.size());
+  frame_wall_power_.assign(model_.picture_frames.size(), 0.0);
+  frame_wall_active_.assign(model_.picture_frames.size(), 0);
+  for (const auto& pf : model_.picture_frames) {
+    if (!(pf.wall_penalty_scale > 0 && pf.wall_penalty_scale <= 1))
+      throw InputError("", "boundary.picture_frame." + pf.name + ".wall_penalty_scale", "must be in (0, 1]");
+    for (const auto& w : pf.walls)
+      for (auto node : w) {
+        if (node < 0 || static_cast<std::size_t>(node) >= n)
+          throw InputError("", "boundary.picture_frame." + pf.name, "wall node outside the mesh");
+        has_walls_ = true;
+      }
+  }
   zero_.assign(3 * n, 0.0);
   if (model_.velocities.size() > 250)
     throw InputError("", "boundary.velocity", "at most 250 prescribed-velocity sets");
@@ -298,6 +316,47 @@ void ExplicitSolver::assemble_mass() {
   }
 }
 
+void ExplicitSolver::frame_wall_forces(const double* x, const double* mass, double dt, double* fc) {
+  wall_contacts_.clear();
+  const double inv_dt2 = 1.0 / (dt * dt);
+  for (std::size_t k = 0; k < model_.picture_frames.size(); ++k) {
+    const auto& pf = model_.picture_frames[k];
+    frame_wall_active_[k] = 0;
+    if (pf.walls[0].empty() && pf.walls[1].empty()) continue;
+    const double g = picture_frame_angle(pf, t_);
+    const double cs = std::cos(0.5 * g), sn = std::sin(0.5 * g);
+    const V3 u1 = cs * pf.arm1 + sn * pf.arm2, u2 = sn * pf.arm1 + cs * pf.arm2;
+    const double s = std::sin(g), c = std::cos(g), L = pf.arm_length;
+    // In-plane unit normals: n1 to the arms along u1 (pointing towards +eta), n2 to those along u2.
+    const V3 n1 = (1.0 / c) * (u2 - s * u1), n2 = (1.0 / c) * (u1 - s * u2);
+    for (int w = 0; w < 2; ++w)
+      for (auto node : pf.walls[static_cast<std::size_t>(w)]) {
+        const auto i = static_cast<std::size_t>(node);
+        const V3 r = V3::at(x + 3 * i) - pf.corner;
+        const double b1 = dot(r, u1), b2 = dot(r, u2);
+        const double xi = (b1 - s * b2) / (c * c), eta = (b2 - s * b1) / (c * c);
+        // Signed distances to the two arms of this pair (positive inside the frame).
+        const double q = w == 0 ? eta : xi, along = w == 0 ? xi : eta;
+        if (along < 0 || along > L) continue;  // the arms are bars from pin to pin
+        const double d_lo = q * c, d_hi = (L - q) * c;
+        double depth = 0, sign = 0;
+        if (d_lo < 0) depth = -d_lo, sign = 1;
+        else if (d_hi < 0) depth = -d_hi, sign = -1;
+        else continue;
+        const double k_pen = pf.wall_penalty_scale * mass[3 * i] * inv_dt2;
+        const V3 F = (sign * k_pen * depth) * (w == 0 ? n1 : n2);
+        fc[3 * i] += F.x, fc[3 * i + 1] += F.y, fc[3 * i + 2] += F.z;
+        WallContact wc;
+        wc.frame = static_cast<std::int32_t>(k);
+        wc.xi = w == 0 ? xi : (sign > 0 ? 0.0 : L);
+        wc.eta = w == 0 ? (sign > 0 ? 0.0 : L) : eta;
+        wc.force = F;
+        wall_contacts_.push_back(wc);
+        ++frame_wall_active_[k];
+      }
+  }
+}
+
 V3 ExplicitSolver::reaction_force(const std::vector<std::int32_t>& nodes) const {
   auto R = reaction.view();
   V3 s;
@@ -340,7 +399,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   double* fi = Fi.data();
   // Arrays a model does not use stay zero and are neither cleared nor read in the node loop.
   const bool has_ext = !model_.loads.empty() || model_.gravity.x != 0 || model_.gravity.y != 0 || model_.gravity.z != 0;
-  const bool has_contact = !model_.tools.empty() || !model_.contacts.empty();
+  const bool has_contact = !model_.tools.empty() || !model_.contacts.empty() || has_walls_;
   const bool has_damp = model_.mass_damping != 0 &&
                         (model_.mass_damping_end_time <= 0 || t_ < model_.mass_damping_end_time);
   std::fill(fi, fi + nd, 0.0);
@@ -368,6 +427,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     c->add_forces(X.data(), Vv.data(), M.data(), dt_c, Fc.data());
     dt_new = std::min(dt_new, c->stable_step_limit());
   }
+  if (has_walls_) frame_wall_forces(X.data(), M.data(), dt_c, Fc.data());
   timers_.contact += seconds_since(t0);
 
   // External forces at t^n, damping from v^{n-1/2}.
@@ -484,6 +544,20 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       const V3 F = tool.motion.force * tool.motion.axis;
       tool_src_old += dot(F, dt_prev_ * vo);
       tool_src_new += dot(F, dt_new * vn);
+    }
+  }
+  // Frame walls: kinematically driven like velocity tools, so their work on the nodes is the
+  // frame's (external) work; the contact energy keeps the penalty energy stored.
+  if (has_walls_) {
+    std::fill(frame_wall_power_.begin(), frame_wall_power_.end(), 0.0);
+    const double t_old = t_ - 0.5 * dt_prev_;
+    for (const auto& wc : wall_contacts_) {
+      const auto& pf = model_.picture_frames[static_cast<std::size_t>(wc.frame)];
+      const double p_old = dot(wc.force, frame_point_velocity(pf, t_old, wc.xi, wc.eta));
+      const double p_new = dot(wc.force, frame_point_velocity(pf, t_half, wc.xi, wc.eta));
+      frame_wall_power_[static_cast<std::size_t>(wc.frame)] += p_new;
+      tool_src_old += dt_prev_ * p_old, tool_src_new += dt_new * p_new;
+      tool_on_nodes_old += dt_prev_ * p_old, tool_on_nodes_new += dt_new * p_new;
     }
   }
   w_tools_.add(tool_src_old, tool_src_new);

@@ -57,6 +57,11 @@ class ExplicitSolver {
 
   /// Sum over the nodes of a DOF-wise reaction of a named constraint (fixed or velocity set).
   V3 reaction_force(const std::vector<std::int32_t>& nodes) const;
+  /// Power (W) the walls of picture frame k (its arms, PictureFrame::walls) put into the nodes
+  /// at t^{n+1/2} of the last cycle; 0 without walls.
+  double frame_wall_power(std::size_t k) const { return k < frame_wall_power_.size() ? frame_wall_power_[k] : 0.0; }
+  /// Nodes in contact with the walls of picture frame k in the last cycle.
+  std::int64_t frame_wall_contacts(std::size_t k) const { return k < frame_wall_active_.size() ? frame_wall_active_[k] : 0; }
 
  private:
   void build_blocks();
@@ -77,6 +82,16 @@ class ExplicitSolver {
   };
   std::vector<FrameDof> frame_dof_;       // per constrained DOF (frame = -1: not a frame DOF)
   std::vector<V3> frame_c1_, frame_c2_;   // per frame: d(u1)/dt, d(u2)/dt this cycle
+  struct WallContact {
+    std::int32_t frame = -1;
+    double xi = 0, eta = 0;  // frame coordinates of the contact point on the arm
+    V3 force;                // on the node, at t^n
+  };
+  std::vector<WallContact> wall_contacts_;  // this cycle's
+  std::vector<double> frame_wall_power_;
+  std::vector<std::int64_t> frame_wall_active_;
+  bool has_walls_ = false;
+  void frame_wall_forces(const double* x, const double* mass, double dt, double* fc);
   std::vector<std::size_t> constrained_;  // DOFs with a fixed or prescribed velocity
   std::vector<double> constrained_vo_;    // their v^{n-1/2} during a cycle
   std::vector<double> zero_;              // [3*n] zeros for force arrays a model does not use

@@ -25,11 +25,15 @@
 //     above, is pushed by both; a node on a flat surface over a seam between two segments is
 //     pushed once.
 //  4. Forces of the active contacts in batches (contact_forces, a branch-free SIMD kernel):
-//     normal k (thickness - gap) plus damping that never pulls, friction from the relative
-//     tangential velocity with an elastic spring per node facet; the force goes on the node and,
-//     weighted by the shape functions, on the segment corners (they sum to zero: momentum is
-//     conserved). Penalty energy is conservative (k fixed from dt0); what friction and damping
-//     take is reported by friction_dissipation().
+//     normal k (thickness - gap - offset) plus damping that never pulls, friction from the
+//     relative tangential velocity with an elastic spring per node facet; the force goes on the
+//     node and, weighted by the shape functions, on the segment corners (they sum to zero:
+//     momentum is conserved). The offset keeps the force continuous: it is the penetration at
+//     which a facet's contact began (a node found already behind a surface, having come round a
+//     tow edge or through a seam, starts from zero force), it is reset at a switch of segment so
+//     that the elastic penetration carries over, and it only shrinks while the contact lasts. So
+//     the penalty stores energy and never creates it (k fixed from dt0); what friction and
+//     damping take is reported by friction_dissipation().
 // Cost is linear in the number of surface nodes; nothing is allocated per cycle (the sort reuses
 // its arrays). Masses are read once in initialise() (they do not change after assembly), so the
 // `mass` argument of add_forces is not used.

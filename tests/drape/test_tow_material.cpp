@@ -48,6 +48,49 @@ TEST(TowMaterial, FibreAndMatrixPhasesAdd) {
   EXPECT_NEAR(s[1], 0.0, 1e-9);
   const auto g = stress_after(m, {{0, 0, 0, 2e-3, 0, 0}});
   EXPECT_NEAR(g[3], 0.2e6 * 2e-3, 1e-9);
+  // Measured by the spacing of the fibre sheets, a shear also brings them closer (by cos): a
+  // second-order compaction, ~1e-10 of the stress here.
+  auto c = paper_tow();
+  c.compaction_of_fibre_sheets = true;
+  const auto gs = stress_after(drape::TowMaterial("tow", c), {{0, 0, 0, 2e-3, 0, 0}});
+  EXPECT_NEAR(gs[3], 0.2e6 * 2e-3, 1e-6 * 0.2e6 * 2e-3);
+}
+
+TEST(TowMaterial, CompactionIsTheSpacingOfTheFibreSheets) {
+  // The fibres rotating against the transverse material line (u2 = k X1) pack the fibre sheets to
+  // 1/sqrt(1 + k^2) of their spacing with E22 = 0: the law sees it as that compaction. The
+  // fibres sliding along each other (u1 = k X2) stretch the transverse line (E22 = k^2/2) but
+  // leave the spacing: no compaction stress.
+  drape::TowConstants c = paper_tow();
+  c.compaction_of_fibre_sheets = true;
+  const drape::TowMaterial m("tow", c);
+  const double k = 0.6;
+  const auto rot = stress_after(m, {{0.5 * k * k, 0, 0, k, 0, 0}});
+  const double E_sheet = 0.5 * (1.0 / (1 + k * k) - 1);
+  ASSERT_LT(E_sheet, -0.4 * m.locking_strain());
+  const double C21 = m.elastic_stiffness()[6];
+  EXPECT_NEAR(rot[1], C21 * 0.5 * k * k + m.compaction_stress(E_sheet), 1e-9 * std::abs(m.compaction_stress(E_sheet)));
+  const auto slide = stress_after(m, {{0, 0.5 * k * k, 0, k, 0, 0}});
+  EXPECT_NEAR(slide[1], m.elastic_stiffness()[7] * 0.5 * k * k, 1e-9 * m.elastic_stiffness()[7]);
+  // The default measure (E22) misses the trellising compaction.
+  const auto rot_e22 = stress_after(drape::TowMaterial("tow", paper_tow()), {{0.5 * k * k, 0, 0, k, 0, 0}});
+  EXPECT_NEAR(rot_e22[1], C21 * 0.5 * k * k, 1e-9);
+  // Hyperelastic: the stress is the gradient of the compaction energy (numerical check of S12).
+  const auto measure = drape::TowMaterial::compaction_measure;
+  std::array<double, 6> E{0.5 * k * k, 0, 0, k, 0, 0};
+  auto energy = [&](const std::array<double, 6>& e) {  // W = int s_c dE2 along E2, numerically
+    const double target = measure(e.data()).E2;
+    double W = 0;
+    const int n = 4000;
+    for (int i = 0; i < n; ++i) W += m.compaction_stress(target * (i + 0.5) / n) * target / n;
+    return W;
+  };
+  const double h = 1e-6;
+  auto Ep = E, Em = E;
+  Ep[3] += h, Em[3] -= h;
+  const double dW = (energy(Ep) - energy(Em)) / (2 * h);  // dW/d(gamma12) = S12
+  const double S12_comp = rot[3] - m.elastic_stiffness()[21] * k;
+  EXPECT_NEAR(S12_comp, dW, 1e-4 * std::abs(dW));
 }
 
 TEST(TowMaterial, CompactionStiffensAndLocks) {

@@ -154,6 +154,9 @@ std::unique_ptr<fem::SolidMaterial> read_material(const TableReader& t, const st
       c.compaction_modulus = t.number("compaction_modulus", 0.0, Range::non_negative());
       c.locking_width_ratio = t.number("locking_width_ratio", 0.7, {0.0, 1.0, true, true});
       c.lock_stiffness_ratio = t.number("lock_stiffness_ratio", 50.0, Range::closed(1, 1e4));
+      c.compaction_of_fibre_sheets =
+          t.choice("compaction_measure", {"transverse_strain", "fibre_sheet_spacing"}, "transverse_strain") ==
+          "fibre_sheet_spacing";
       return std::make_unique<drape::TowMaterial>(name, c);
     }
     if (type == "elastic_isotropic") {
@@ -581,6 +584,9 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       pf.arm1 = a1, pf.arm2 = a2;
       pf.arm_length = t.number("arm_length", Range::positive());
       pf.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
+      if (t.has("wall_nodes_arm1")) pf.walls[0] = select_nodes(t, "wall_nodes_arm1", mesh);
+      if (t.has("wall_nodes_arm2")) pf.walls[1] = select_nodes(t, "wall_nodes_arm2", mesh);
+      pf.wall_penalty_scale = t.number("wall_penalty_scale", 0.1, Range::open_closed(0, 1));
       frame_final_angles.push_back(t.number("final_shear_angle_deg", Range::open_closed(0, 80)) * M_PI / 180.0);
       ec.frame_fabric_length.push_back(t.number("fabric_length", pf.arm_length, Range::positive()));
       ec.model.picture_frames.push_back(std::move(pf));

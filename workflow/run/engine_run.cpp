@@ -352,7 +352,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
       const auto& pf = model.picture_frames[k];
       const double g = fem::picture_frame_angle(pf, solver.time()), gd = fem::picture_frame_rate(pf, solver.time());
       const double theta = 0.25 * M_PI - 0.5 * g, ddot = pf.arm_length * std::sin(theta) * gd;
-      double power = 0;
+      double power = solver.frame_wall_power(k);  // the arms as walls push the edge tows
       {
         auto R = solver.reaction.view();
         auto Vn = solver.v.view();
