@@ -316,7 +316,8 @@ TEST(CliRegression, PictureFrameForceRisesAtTheGapClosingAngle) {
 
 // Virtual bias extension (250 x 100 mm, +-45 NCF tow by tow, coarse mesh): up to 10 mm the central
 // shear angle stays within 3 deg of Eq. 2, beyond it falls below (inter-tow slip); positive and
-// negative shear give different forces (shear bias: the pillars carry the positive case).
+// negative shear give different forces (shear bias: the pillars carry the positive case). Pulled at
+// 1 m/s (about 2 min each).
 namespace {
 nlohmann::json run_bias_extension(const std::string& sign) {
   const fs::path out = fresh_dir("bias_" + sign);
