@@ -481,8 +481,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
       const std::int32_t was = last[fi];
       last[fi] = best_seg[fi];
       if (best_seg[fi] < 0) {
-        ft[0] = ft[1] = ft[2] = 0;
-        offset[fi] = 0, elastic[fi] = 0;
+        if (was >= 0) ft[0] = ft[1] = ft[2] = 0, offset[fi] = 0, elastic[fi] = 0;  // else zero
         continue;
       }
       ++n_active;
