@@ -119,7 +119,6 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
   cand_seg_.clear();
   const std::size_t n_blocks = (n_seg + kFrameLanes - 1) / kFrameLanes;
   frame_.resize(n_blocks * kFrameLanes);
-  n_frame_blocks_ = n_blocks;
   box_lo_.resize(3 * active_seg_.size());
   box_hi_.resize(3 * active_seg_.size());
   pair_force_.assign(cfg_.pairs.size(), V3{});
@@ -128,24 +127,30 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
   sort_segments(setup.x0);
 }
 
-void PenaltyContact::compute_frames(const double* x, std::size_t blk) {
-  const std::size_t n_seg = surf_.n_segments(), s0 = blk * kFrameLanes;
+void PenaltyContact::block_frames(const double* x, const std::int32_t* seg, std::size_t n,
+                                  SegmentFrameBlock& fb) const {
   const std::int32_t* sn = surf_.seg_nodes.data();
   alignas(64) double p[4][3][kFrameLanes];
   alignas(64) double depth[kFrameLanes];
-  for (int l = 0; l < kFrameLanes; ++l) {
-    const std::size_t s =
-        std::min(s0 + static_cast<std::size_t>(l), n_seg - 1);  // pad with the last
-    for (int a = 0; a < 4; ++a) {
-      const double* q = x + 3 * static_cast<std::size_t>(sn[4 * s + static_cast<std::size_t>(a)]);
+  for (std::size_t l = 0; l < kFrameLanes; ++l) {
+    const auto s = static_cast<std::size_t>(seg[std::min(l, n - 1)]);  // pad with the last
+    for (std::size_t a = 0; a < 4; ++a) {
+      const double* q = x + 3 * static_cast<std::size_t>(sn[4 * s + a]);
       p[a][0][l] = q[0], p[a][1][l] = q[1], p[a][2][l] = q[2];
     }
     depth[l] = depth_[s];
   }
-  SegmentFrameBlock fb;
   segment_frames(p, depth, fb);
-  // Lanes to records: the node loop reads a frame through a candidate index, 2 cache lines each.
+}
+
+void PenaltyContact::compute_frames(const double* x, std::size_t blk) {
+  const std::size_t n_seg = surf_.n_segments(), s0 = blk * kFrameLanes;
   const std::size_t n_lanes = std::min<std::size_t>(kFrameLanes, n_seg - s0);
+  std::int32_t seg[kFrameLanes];
+  for (std::size_t l = 0; l < n_lanes; ++l) seg[l] = static_cast<std::int32_t>(s0 + l);
+  SegmentFrameBlock fb;
+  block_frames(x, seg, n_lanes, fb);
+  // Lanes to records: the sort reads a frame through a segment index.
   for (std::size_t l = 0; l < n_lanes; ++l) {
     SegmentFrame& f = frame_[s0 + l];
     for (int k = 0; k < 3; ++k)
@@ -195,7 +200,7 @@ void PenaltyContact::sort_segments(const double* x) {
   const std::size_t ng = n_groups_, n_node = surf_.n_nodes(), n_act = active_seg_.size();
   const double margin = margin_;
   // Frames of all segments, grown boxes of the active ones.
-  for (std::size_t blk = 0; blk < n_frame_blocks_; ++blk) compute_frames(x, blk);
+  for (std::size_t blk = 0; blk < frame_.size() / kFrameLanes; ++blk) compute_frames(x, blk);
   for (std::size_t a = 0; a < n_act; ++a) {
     const auto s = static_cast<std::size_t>(active_seg_[a]);
     double p[4][3];
@@ -402,20 +407,10 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     const std::int32_t* ustart = used_cand_start_.data();
     const std::int32_t* unode = ucand_node_.data();
     const std::int32_t* ufacet = ucand_facet_.data();
-    alignas(64) double p[4][3][kFrameLanes];
-    alignas(64) double depth[kFrameLanes];
     SegmentFrameBlock fb;
     for (std::size_t u0 = 0; u0 < n_used; u0 += kFrameLanes) {
       const std::size_t n_lanes = std::min<std::size_t>(kFrameLanes, n_used - u0);
-      for (std::size_t l = 0; l < kFrameLanes; ++l) {
-        const auto q = static_cast<std::size_t>(used[std::min(u0 + l, n_used - 1)]);
-        for (int c = 0; c < 4; ++c) {
-          const double* xc = x + 3 * static_cast<std::size_t>(sn[4 * q + static_cast<std::size_t>(c)]);
-          p[c][0][l] = xc[0], p[c][1][l] = xc[1], p[c][2][l] = xc[2];
-        }
-        depth[l] = depth_[q];
-      }
-      segment_frames(p, depth, fb);
+      block_frames(x, used + u0, n_lanes, fb);
       for (std::size_t l = 0; l < n_lanes; ++l) {
         const std::int32_t s = used[u0 + l];
         const std::int32_t* adj = seg_adj + 4 * static_cast<std::size_t>(s);

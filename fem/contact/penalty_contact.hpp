@@ -87,6 +87,9 @@ class PenaltyContact final : public ContactAlgorithm {
  private:
   void sort_segments(const double* x);                      // broad phase at positions x
   void compute_frames(const double* x, std::size_t block);  // frames of one block at x (sort)
+  /// Frames at x of the n <= kFrameLanes segments seg[0..n) in SIMD lanes (the rest padded).
+  void block_frames(const double* x, const std::int32_t* seg, std::size_t n,
+                    SegmentFrameBlock& fb) const;
   /// Closest-feature test of a contact of penetration pen on a segment, against the outer faces
   /// adjacent to it in the same hexahedron (adj[4], -1 padded) that are opposed to one of the
   /// node's nf facets (fn[nf][3]). True (not the contact) when, for such a face, the node at p
@@ -114,11 +117,11 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<double> x_sorted_;           // [n_snode][3] positions at the last sort
   std::vector<double> tangential_;         // [n_facet][3] elastic friction force per node facet, N
   std::vector<std::int32_t> facet_start_;  // [n_snode + 1] first facet of each surface node
+  std::vector<double> tangential_old_;     // the two above before the last sort (carried over)
+  std::vector<std::int32_t> facet_start_old_;
   std::vector<double> offset_;   // [n_facet] penetration offset of the contact (no force jump), m
   std::vector<double> elastic_;  // [n_facet] penetration past the offset in the last cycle, m
   std::vector<double> offset_old_, elastic_old_;  // before the last sort (carried over)
-  std::vector<double> tangential_old_;     // the two above before the last sort (carried over)
-  std::vector<std::int32_t> facet_start_old_;
   std::vector<std::int32_t> last_seg_;      // [n_facet] contact segment of each node facet in the
   std::vector<std::int32_t> last_seg_old_;  // last cycle, -1: none (and before the last sort)
   std::vector<double> node_mass_;          // [n_nodes] lumped nodal masses (fixed after set-up), kg
@@ -137,7 +140,6 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<std::int32_t> best_seg_;  // [n_facet] -1: no contact this cycle
   std::vector<double> best_gap_;        // [n_facet]
   std::vector<BestHit> best_;           // [n_facet] valid where best_seg_ >= 0
-  std::size_t n_frame_blocks_ = 0;
   std::vector<SegmentFrame> frame_;  // [n_blocks * kFrameLanes] all frames, made at the sort
   std::vector<double> box_lo_, box_hi_;    // [n_seg][3] grown segment boxes at the sort
   std::vector<double> facet_;              // [n_snode][kMaxFacets][3] facet normals at the sort
