@@ -20,65 +20,12 @@
 
 #include "drape/stitch_calibration.hpp"
 #include "fem/io/result_reader.hpp"
+#include "tests/workflow/cli_test_support.hpp"
 
 namespace fs = std::filesystem;
+using namespace ncfsim::test;
 
 namespace {
-
-const fs::path kExe = NCFSIM_EXE;
-const fs::path kSource = NCFSIM_SOURCE_DIR;
-
-struct Result {
-  int code = -1;
-  std::string output;  // stdout + stderr
-};
-
-pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    ::unsetenv("DISPLAY");
-    std::vector<char*> argv;
-    std::string exe = kExe.string();
-    argv.push_back(exe.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(exe.c_str(), argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-int wait_code(pid_t pid) {
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-Result run_cli(const std::vector<std::string>& args) {
-  const fs::path log = fs::temp_directory_path() / ("ncfsim_cli_" + std::to_string(getpid()) + ".log");
-  Result r;
-  r.code = wait_code(spawn(args, log));
-  r.output = slurp(log);
-  fs::remove(log);
-  return r;
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("ncfsim_test_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  return d;
-}
 
 }  // namespace
 
@@ -287,23 +234,12 @@ TEST(CliRegression, PictureFrameForceRisesAtTheGapClosingAngle) {
                             "--set", "time.end_time=0.03", "--set", "output.figures=false", "--set",
                             "output.report=false"});
   ASSERT_EQ(r.code, 0) << r.output;
-  std::ifstream in(out / "history.csv");
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> cols;
-  {
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) cols.push_back(c);
-  }
-  const auto col = [&](const std::string& n) { return std::find(cols.begin(), cols.end(), n) - cols.begin(); };
-  const auto ca = col("frame_shear_angle_deg"), cf = col("frame_normalised_shear_force_N_per_m");
-  ASSERT_LT(static_cast<std::size_t>(cf), cols.size());
+  const History h = read_history(out / "history.csv");
+  const auto ca = h.column("frame_shear_angle_deg"), cf = h.column("frame_normalised_shear_force_N_per_m");
+  ASSERT_LT(cf, h.columns.size());
   double before = 0, at28 = 0;
-  while (std::getline(in, line)) {
-    std::vector<double> v;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) v.push_back(std::stod(c));
-    const double g = v[static_cast<std::size_t>(ca)], f = v[static_cast<std::size_t>(cf)];
+  for (const auto& v : h.rows) {
+    const double g = v[ca], f = v[cf];
     if (g > 4.0 && g < 12.5) before = std::max(before, std::abs(f));  // after the start-up ramp
     if (g > 27.5 && g < 28.5) at28 = f;
   }

@@ -5,67 +5,28 @@
 // per sliding distance, with a clean energy balance. Coarse meshes (about 15 s for the three on the
 // 2-core development VM; the case files' default meshes meet the same 2 %).
 #include <gtest/gtest.h>
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "tests/workflow/cli_test_support.hpp"
+
 namespace fs = std::filesystem;
+using namespace ncfsim::test;
 
 namespace {
 
-const fs::path kExe = NCFSIM_EXE;
-const fs::path kSource = NCFSIM_SOURCE_DIR;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// Runs ncfsim with args; returns the exit code, stdout + stderr into `output`.
-int run_ncfsim(const std::vector<std::string>& args, std::string& output) {
-  const fs::path log = fs::temp_directory_path() / ("ncfsim_sled_" + std::to_string(getpid()) + ".log");
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    ::unsetenv("DISPLAY");
-    std::string exe = kExe.string();
-    std::vector<std::string> copy = args;
-    std::vector<char*> argv{exe.data()};
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(exe.c_str(), argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  output = slurp(log);
-  fs::remove(log);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
 // Runs cases/drape/<name>.toml on the coarse mesh and checks mu against the input.
 void check_sled(const std::string& name, double mu_input) {
-  const fs::path out = fs::temp_directory_path() / ("ncfsim_test_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(out);
-  std::string log;
-  const int code = run_ncfsim({"-q", "run", (kSource / "cases/drape" / (name + ".toml")).string(), "-o", out.string(),
-                               "--set", "mesh.resolution=coarse", "--set", "output.frames=none", "--set",
-                               "output.figures=false", "--set", "output.report=false"},
-                              log);
-  ASSERT_EQ(code, 0) << log;
+  const fs::path out = fresh_dir(name);
+  const Result r = run_cli({"-q", "run", (kSource / "cases/drape" / (name + ".toml")).string(), "-o", out.string(),
+                            "--set", "mesh.resolution=coarse", "--set", "output.frames=none", "--set",
+                            "output.figures=false", "--set", "output.report=false"});
+  ASSERT_EQ(r.code, 0) << r.output;
   const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
   EXPECT_EQ(s["status"], "completed");
   ASSERT_TRUE(s["friction_coefficient"].is_number()) << s.dump(2);

@@ -10,64 +10,22 @@
 //   gives no order, its Fig. 6c is not available: this is the model's order, see
 //   docs/fabric-data.md).
 #include <gtest/gtest.h>
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "tests/workflow/cli_test_support.hpp"
+
 namespace fs = std::filesystem;
+using namespace ncfsim::test;
 
 namespace {
-
-const fs::path kExe = NCFSIM_EXE;
-const fs::path kSource = NCFSIM_SOURCE_DIR;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct Result {
-  int code = -1;
-  std::string output;
-};
-
-Result run_cli(const std::vector<std::string>& args) {
-  const fs::path log = fs::temp_directory_path() / ("ncfsim_pf_" + std::to_string(getpid()) + ".log");
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    ::unsetenv("DISPLAY");
-    std::vector<std::string> copy = args;
-    std::string exe = kExe.string();
-    std::vector<char*> argv{exe.data()};
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(exe.c_str(), argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.output = slurp(log);
-  fs::remove(log);
-  return r;
-}
 
 struct FrameRun {
   nlohmann::json summary;
@@ -75,8 +33,7 @@ struct FrameRun {
 };
 
 FrameRun run_frame(const std::string& which, const std::vector<std::string>& extra = {}) {
-  const fs::path out = fs::temp_directory_path() / ("ncfsim_test_pf_" + which + "_" + std::to_string(getpid()));
-  fs::remove_all(out);
+  const fs::path out = fresh_dir("pf_" + which);
   std::vector<std::string> args{"-q", "run", (kSource / ("cases/drape/picture_frame_" + which + ".toml")).string(),
                                 "-o", out.string(), "--set", "output.figures=false", "--set", "output.report=false",
                                 "--set", "output.frames=none"};
@@ -85,25 +42,11 @@ FrameRun run_frame(const std::string& which, const std::vector<std::string>& ext
   EXPECT_EQ(r.code, 0) << r.output;
   FrameRun run;
   if (fs::exists(out / "summary.json")) run.summary = nlohmann::json::parse(slurp(out / "summary.json"));
-  std::ifstream in(out / "history.csv");
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> cols;
-  {
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) cols.push_back(c);
-  }
-  const auto col = [&](const std::string& n) {
-    return static_cast<std::size_t>(std::find(cols.begin(), cols.end(), n) - cols.begin());
-  };
-  const std::size_t ca = col("frame_shear_angle_deg"), cf = col("frame_normalised_shear_force_N_per_m");
-  EXPECT_LT(cf, cols.size());
-  while (cf < cols.size() && std::getline(in, line)) {
-    std::vector<double> v;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) v.push_back(std::stod(c));
-    run.curve.emplace_back(v[ca], v[cf]);
-  }
+  const History h = read_history(out / "history.csv");
+  const std::size_t ca = h.column("frame_shear_angle_deg"), cf = h.column("frame_normalised_shear_force_N_per_m");
+  EXPECT_LT(cf, h.columns.size());
+  if (cf < h.columns.size())
+    for (const auto& v : h.rows) run.curve.emplace_back(v[ca], v[cf]);
   fs::remove_all(out);
   return run;
 }

@@ -1,0 +1,107 @@
+#pragma once
+// Helpers of the end-to-end tests that run the ncfsim executable (NCFSIM_EXE, from the sources in
+// NCFSIM_SOURCE_DIR): spawn it with DISPLAY unset and its output in a log, read files back, read
+// history.csv by column name.
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace ncfsim::test {
+
+namespace fs = std::filesystem;
+
+inline const fs::path kExe = NCFSIM_EXE;
+inline const fs::path kSource = NCFSIM_SOURCE_DIR;
+
+struct Result {
+  int code = -1;
+  std::string output;  // stdout + stderr
+};
+
+inline std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Starts ncfsim with args, stdout and stderr into `log`; returns the child's pid.
+inline pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    ::unsetenv("DISPLAY");
+    std::vector<char*> argv;
+    std::string exe = kExe.string();
+    argv.push_back(exe.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(exe.c_str(), argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Exit code of the child (128 + signal when it was killed).
+inline int wait_code(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+/// Runs ncfsim with args to the end.
+inline Result run_cli(const std::vector<std::string>& args) {
+  const fs::path log = fs::temp_directory_path() / ("ncfsim_cli_" + std::to_string(getpid()) + ".log");
+  Result r;
+  r.code = wait_code(spawn(args, log));
+  r.output = slurp(log);
+  fs::remove(log);
+  return r;
+}
+
+/// An output folder in the temporary directory that does not exist yet.
+inline fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("ncfsim_test_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+/// history.csv: column names and rows of numbers.
+struct History {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+  /// Index of a column; columns.size() when there is none.
+  std::size_t column(const std::string& name) const {
+    return static_cast<std::size_t>(std::find(columns.begin(), columns.end(), name) - columns.begin());
+  }
+};
+
+inline History read_history(const fs::path& file) {
+  History h;
+  std::ifstream in(file);
+  std::string line;
+  if (!std::getline(in, line)) return h;
+  {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) h.columns.push_back(c);
+  }
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) v.push_back(std::stod(c));
+    h.rows.push_back(std::move(v));
+  }
+  return h;
+}
+
+}  // namespace ncfsim::test
