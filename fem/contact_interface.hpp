@@ -46,6 +46,9 @@ class ContactAlgorithm {
   virtual double stable_step_limit() const { return 1e300; }
   /// Number of active contacts after the last add_forces (diagnostics).
   virtual std::int64_t active_contacts() const { return 0; }
+  /// The hexahedra `mesh_hexes` (indices into Mesh::hexes) were eroded: their faces stop being
+  /// contact segments from the next add_forces on.
+  virtual void erode(const std::vector<std::int32_t>& mesh_hexes) { (void)mesh_hexes; }
 };
 
 }  // namespace ncfsim::fem

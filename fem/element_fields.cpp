@@ -1,5 +1,6 @@
 #include "fem/element_fields.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "fem/hex8_basis.hpp"
@@ -59,6 +60,7 @@ void hex8_output_fields(const Hex8Block& b, const double* x, double* cauchy, dou
       }
     double* out = cauchy + 6 * e;
     out[0] = sg[0], out[1] = sg[4], out[2] = sg[8], out[3] = sg[1], out[4] = sg[5], out[5] = sg[2];
+    if (b.n_eroded && b.eroded[e]) std::fill(out, out + 6, 0.0);  // carries nothing
     vm[e] = von_mises(out);
     const double fx = FM[0], fy = FM[3], fz = FM[6];
     const double len = std::sqrt(fx * fx + fy * fy + fz * fz);

@@ -26,6 +26,8 @@ struct EnergyBalance {
   double damping = 0;        // dissipated by mass damping
   double external_work = 0;  // applied loads, gravity, supports, tools
   double initial_total = 0;  // kinetic + internal at t = 0
+  double eroded_internal = 0;  // elastic energy held by eroded elements when they went (part of
+                               // internal: it stays counted there, it is no longer recoverable)
 
   double total() const { return kinetic + internal + hourglass + contact + damping; }
   /// |E - E0 - W_ext| over the largest energy in play.

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 
@@ -189,6 +190,10 @@ void hex8_lumped_mass(const Hex8Block& b, double* mass) {
 void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt) {
   dt.resize(b.n);
   for (std::size_t e = 0; e < b.n; ++e) {
+    if (b.n_eroded && b.eroded[e]) {
+      dt[e] = 1e300;
+      continue;
+    }
     Vec3 xe[8];
     gather(b, e, x, xe);
     HexGeometry g;
@@ -196,6 +201,40 @@ void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>
     const double lc = g.V / std::sqrt(max_face_area_sq(xe));
     dt[e] = lc / std::sqrt(b.p_modulus / b.density[e]);
   }
+}
+
+void hex8_corner_jacobians(const Hex8Block& b, const double* x, std::vector<double>& jmin) {
+  // The three edges leaving each corner, right-handed (bottom face 0-3, top 4-7 above them).
+  constexpr int kEdges[8][3] = {{1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7},
+                                {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}};
+  jmin.resize(b.n);
+  for (std::size_t e = 0; e < b.n; ++e) {
+    if (b.n_eroded && b.eroded[e]) {
+      jmin[e] = 1.0;
+      continue;
+    }
+    Vec3 xe[8];
+    gather(b, e, x, xe);
+    double j = 1e300;
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 o = xe[c];
+      j = std::min(j, dot(cross(xe[kEdges[c][0]] - o, xe[kEdges[c][1]] - o), xe[kEdges[c][2]] - o));
+    }
+    jmin[e] = j / b.volume0[e];
+  }
+}
+
+double hex8_erode(Hex8Block& b, std::size_t e) {
+  const std::size_t n = b.n;
+  if (b.eroded.empty()) b.eroded.assign(n, 0);
+  if (b.eroded[e]) return 0.0;
+  b.eroded[e] = 1;
+  ++b.n_eroded;
+  double w = 0;
+  for (int c = 0; c < 6; ++c) w += b.stress[c * n + e] * b.strain[c * n + e];
+  for (int c = 0; c < 6; ++c) b.stress[c * n + e] = 0.0, b.strain[c * n + e] = 0.0;
+  for (int k = 0; k < 12; ++k) b.hg_force[k * n + e] = 0.0;
+  return 0.5 * w * b.volume0[e];
 }
 
 StableStep hex8_stable_step(const Hex8Block& b, const double* x) {
@@ -263,8 +302,10 @@ inline void basis_transpose(const VD w[8], VD f[8]) {
 }  // namespace
 
 void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double dt, double* f,
-                          ElementEnergyIncrement& energy, StableStep& step) {
+                          ElementEnergyIncrement& energy, StableStep& step, const double* x_ref) {
   const std::size_t n = b.n;
+  const std::uint8_t* dead = b.n_eroded ? b.eroded.data() : nullptr;
+  if (dead && !x_ref) throw std::logic_error("hex8_internal_forces: eroded elements need x_ref");
   // Chunk scratch, [component][CH]: what the force pass needs from the kinematics pass.
   alignas(64) double deps[6][CH];
   alignas(64) double sig_old[6][CH];
@@ -330,9 +371,18 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         const std::int32_t* ci = conn + I * n + e;
         std::size_t idx[W];
         for (int l = 0; l < W; ++l) idx[l] = 3 * static_cast<std::size_t>(ci[l < cnt ? l : cnt - 1]);
-        for (int c = 0; c < 3; ++c) {
-          xu[c][I] = VD([&](auto l) { return x[idx[l] + c]; });
-          vu[c][I] = VD([&](auto l) { return v[idx[l] + c]; });
+        if (!dead) {
+          for (int c = 0; c < 3; ++c) {
+            xu[c][I] = VD([&](auto l) { return x[idx[l] + c]; });
+            vu[c][I] = VD([&](auto l) { return v[idx[l] + c]; });
+          }
+        } else {  // eroded lanes: at rest in the reference shape, so F = I and nothing moves
+          bool d[W];
+          for (int l = 0; l < W; ++l) d[l] = dead[e + static_cast<std::size_t>(l < cnt ? l : cnt - 1)] != 0;
+          for (int c = 0; c < 3; ++c) {
+            xu[c][I] = VD([&](auto l) { return (d[l] ? x_ref : x)[idx[l] + c]; });
+            vu[c][I] = VD([&](auto l) { return d[l] ? 0.0 : v[idx[l] + c]; });
+          }
         }
       }
       // Largest face area (stable step), from the nodes before they are transformed.
@@ -453,8 +503,12 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       store(b.volume.data() + e, V, cnt);
       const VD V0 = load(vol0 + e, cnt);
       VD sm[6], wint = 0.0;
+      batch::VD::mask_type is_dead(false);
+      if (dead)
+        for (int l = 0; l < cnt; ++l) is_dead[l] = dead[e + static_cast<std::size_t>(l)] != 0;
       for (int c = 0; c < 6; ++c) {
         sm[c] = load(stress + c * n + e, cnt);
+        stdx::where(is_dead, sm[c]) = 0.0;  // whatever the material did with a zero increment
         const VD de = load_a(&deps[c][j]);
         wint += 0.5 * (sm[c] + load_a(&sig_old[c][j])) * de;
         store(strain + c * n + e, load(strain + c * n + e, cnt) + de, cnt);
@@ -568,7 +622,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         }
     }
     for (int j = 0; j < m; ++j)
-      if (dtc[j] < step.dt) step = {dtc[j], b.user_id[e0 + static_cast<std::size_t>(j)], false};
+      if (dtc[j] < step.dt && !(dead && dead[e0 + static_cast<std::size_t>(j)]))
+        step = {dtc[j], b.user_id[e0 + static_cast<std::size_t>(j)], false};
   }
   energy.internal += stdx::reduce(e_int) + stdx::reduce(e_stab);
   energy.stabilisation += stdx::reduce(e_stab);

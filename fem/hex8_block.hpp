@@ -36,6 +36,9 @@ struct Hex8Block {
   std::vector<double> volume;          // [n] current volume
   std::vector<double> volume0;         // [n] reference volume
   std::vector<double> density;         // [n] density incl. mass scaling
+  std::vector<std::int32_t> mesh_hex;  // [n] index into Mesh::hexes (contact surfaces refer to it)
+  std::vector<std::uint8_t> eroded;    // [n] 1: removed from the calculation (empty: none yet)
+  std::size_t n_eroded = 0;
   double hourglass_stiffness = 1.0;    // scale of the physical stabilisation (1 = exact bending)
   double hourglass_viscosity = 0.05;   // fraction of critical damping on the hourglass modes
   double p_modulus = 0.0;              // modulus of the stable-step bound (uniform-strain hex)
@@ -61,14 +64,28 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
 /// Element nodal masses (rho V / 8) added into `mass` [3*n_nodes].
 void hex8_lumped_mass(const Hex8Block& b, double* mass);
 
-/// Stable time step of every element (characteristic length V/A_max over wave speed).
+/// Stable time step of every element (characteristic length V/A_max over wave speed); an eroded
+/// element has none (1e300).
 StableStep hex8_stable_step(const Hex8Block& b, const double* x);
 void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt);
+
+/// Smallest corner Jacobian of each element at x (the triple product of the three edges leaving a
+/// corner, over the reference volume; 1 for an undistorted box, <= 0 where the element folds over
+/// at that corner, which the one-point volume does not see). Eroded elements get 1.
+void hex8_corner_jacobians(const Hex8Block& b, const double* x, std::vector<double>& jmin);
+
+/// Erodes element e: from now on it adds no force, no energy and no step limit; its nodes keep
+/// their mass. Returns the elastic energy it held, 1/2 S:E V0 (exact for a linear law in
+/// Green-Lagrange strain), which leaves the model with it.
+double hex8_erode(Hex8Block& b, std::size_t e);
 
 /// Internal forces at positions x with velocities v (that moved the nodes over the last step dt):
 /// updates stress and hourglass state, subtracts internal forces from f [3*n_nodes], accumulates
 /// energy increments and the stable step. Throws NumericalError on a negative or NaN volume.
+/// Eroded elements are evaluated at the reference positions x_ref at rest, with zero stress (no
+/// force, no work, whatever their nodes do); x_ref may be null while the block has none.
 void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double dt, double* f,
-                          ElementEnergyIncrement& energy, StableStep& step);
+                          ElementEnergyIncrement& energy, StableStep& step,
+                          const double* x_ref = nullptr);
 
 }  // namespace ncfsim::fem

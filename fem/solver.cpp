@@ -10,6 +10,7 @@ namespace ncfsim::fem {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+constexpr std::int64_t kFoldCheckInterval = 10;  // cycles between searches for folded hexahedra
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -235,9 +236,11 @@ void ExplicitSolver::build_blocks() {
       b.n = hexes.size();
       b.conn.resize(8 * b.n);
       b.user_id.resize(b.n);
+      b.mesh_hex.resize(b.n);
       for (std::size_t j = 0; j < b.n; ++j) {
         for (int I = 0; I < 8; ++I) b.conn[I * b.n + j] = mesh.hexes[hexes[j]][I];
         b.user_id[j] = mesh.hex_user_id[hexes[j]];
+        b.mesh_hex[j] = static_cast<std::int32_t>(hexes[j]);
       }
       b.hourglass_stiffness = pp.hourglass_stiffness;
       b.hourglass_viscosity = pp.hourglass_viscosity;
@@ -279,6 +282,54 @@ void ExplicitSolver::apply_mass_scaling() {
       if (sf * b.dt_crit[e] < target) b.mass_scale[e] = std::pow(target / (sf * b.dt_crit[e]), 2);
     bar_initialise(b, X.data());
   }
+}
+
+std::string ExplicitSolver::element_position(const StableStep& st, const double* x) const {
+  auto centre = [&](const std::int32_t* conn, std::size_t stride, std::size_t e, int nn) {
+    V3 c;
+    for (int I = 0; I < nn; ++I)
+      c += (1.0 / nn) * V3::at(x + 3 * static_cast<std::size_t>(conn[static_cast<std::size_t>(I) * stride + e]));
+    std::ostringstream os;
+    os << "(" << c.x << ", " << c.y << ", " << c.z << ") m";
+    return os.str();
+  };
+  if (st.is_bar) {
+    for (const auto& b : bar_)
+      for (std::size_t e = 0; e < b.n; ++e)
+        if (b.user_id[e] == st.element) return centre(b.conn.data(), b.n, e, 2);
+  } else {
+    for (const auto& b : hex_)
+      for (std::size_t e = 0; e < b.n; ++e)
+        if (b.user_id[e] == st.element) return centre(b.conn.data(), b.n, e, 8);
+  }
+  return "(unknown position)";
+}
+
+StableStep ExplicitSolver::erode(const double* x, double dt_erode) {
+  const double sf = model_.time.safety_factor;
+  std::vector<std::int32_t> gone;
+  StableStep left;
+  for (auto& b : hex_) {
+    hex8_element_steps(b, x, step_scratch_);
+    hex8_corner_jacobians(b, x, jacobian_scratch_);
+    for (std::size_t e = 0; e < b.n; ++e) {
+      const double dt = step_scratch_[e];
+      const bool folded = !(jacobian_scratch_[e] > 0);
+      if (!(sf * dt < dt_erode) && !folded) {
+        if (dt < left.dt) left = {dt, b.user_id[e], false};
+        continue;
+      }
+      using Cause = ErosionEvent::Cause;
+      ErosionEvent ev{folded ? Cause::InvertedCorner : Cause::StableStep, t_, cycle_, b.user_id[e], b.part, sf * dt, {}};
+      for (int I = 0; I < 8; ++I) ev.centroid += 0.125 * V3::at(x + 3 * static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * b.n + e]));
+      energy_.eroded_internal += hex8_erode(b, e);
+      gone.push_back(b.mesh_hex[e]);
+      erosions_.push_back(ev);
+    }
+  }
+  if (!gone.empty())
+    for (auto& c : model_.contacts) c->erode(gone);
+  return left;
 }
 
 void ExplicitSolver::assemble_mass() {
@@ -378,7 +429,7 @@ void ExplicitSolver::check_finite(const double* vel) const {
            << X[3 * i] << ", " << X[3 * i + 1] << ", " << X[3 * i + 2]
            << ") m is not finite at t = " << t_ << " s, cycle " << cycle_
            << "; the stable step is controlled by " << (step_.is_bar ? "bar " : "hexahedron ")
-           << step_.element;
+           << step_.element << " at " << element_position(step_, X.data());
         throw NumericalError(os.str());
       }
 }
@@ -409,7 +460,15 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   // Internal forces at x^n from v^{n-1/2}.
   ElementEnergyIncrement inc;
   StableStep st;
-  for (auto& b : hex_) hex8_internal_forces(b, X.data(), Vv.data(), dt_prev_, fi, inc, st);
+  {
+    auto X0 = x0.view();
+    for (auto& b : hex_) hex8_internal_forces(b, X.data(), Vv.data(), dt_prev_, fi, inc, st, X0.data());
+  }
+  // Erosion: a step below the limit is seen at once; folded corners, which develop over many
+  // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
+  const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
+  if (dt_erode > 0 && (model_.time.safety_factor * st.dt < dt_erode || cycle_ % kFoldCheckInterval == 0))
+    st = erode(X.data(), dt_erode);
   for (auto& b : bar_) bar_internal_forces(b, X.data(), fi, inc, st);
   energy_.internal += inc.internal;
   energy_.stabilisation += inc.stabilisation;
@@ -451,7 +510,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     os << "numerical instability: the stable time step fell to " << dt_new << " s ("
        << dt_new / dt_initial_ << " of the initial " << dt_initial_ << " s) at t = " << t_
        << " s, cycle " << cycle_ << "; controlled by " << (st.is_bar ? "bar " : "hexahedron ")
-       << st.element << " (severely distorted or inverted)";
+       << st.element << " at " << element_position(st, X.data()) << " (severely distorted or inverted)";
     throw NumericalError(os.str());
   }
 

@@ -22,6 +22,18 @@ struct PartMassReport {
   double added_mass = 0;  // mass added by mass scaling, kg
 };
 
+/// One hexahedron removed by erosion.
+struct ErosionEvent {
+  enum class Cause { StableStep, InvertedCorner };
+  Cause cause = Cause::StableStep;
+  double time = 0;
+  std::int64_t cycle = 0;
+  std::int64_t element = 0;  // user id
+  int part = 0;
+  double step = 0;           // its stable step when eroded (times the safety factor), s
+  V3 centroid;               // m
+};
+
 struct PhaseTimers {
   double internal_force = 0, contact = 0, update = 0, output = 0;  // seconds
 };
@@ -41,6 +53,8 @@ class ExplicitSolver {
   const EnergyBalance& energy() const { return energy_; }
   const StableStep& controlling_element() const { return step_; }
   const std::vector<PartMassReport>& part_masses() const { return part_mass_; }
+  /// Hexahedra eroded so far (time.erosion_step_ratio), in order.
+  const std::vector<ErosionEvent>& erosions() const { return erosions_; }
   const PhaseTimers& timers() const { return timers_; }
   std::size_t n_hexes() const;
   std::size_t n_bars() const;
@@ -68,11 +82,19 @@ class ExplicitSolver {
   void apply_mass_scaling();
   void assemble_mass();
   void check_finite(const double* vel) const;
+  /// Erodes every hexahedron whose step at x (times the safety factor) is below dt_erode or
+  /// one of whose corners has folded over (corner Jacobian <= 0); returns the stable step of
+  /// those left.
+  StableStep erode(const double* x, double dt_erode);
+  /// "(x, y, z) m": centroid at x of the element a StableStep names (for messages).
+  std::string element_position(const StableStep& st, const double* x) const;
 
   Model& model_;
   std::vector<Hex8Block> hex_;
   std::vector<BarBlock> bar_;
   std::vector<PartMassReport> part_mass_;
+  std::vector<ErosionEvent> erosions_;
+  std::vector<double> step_scratch_, jacobian_scratch_;
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
   std::vector<V3> vpres_;

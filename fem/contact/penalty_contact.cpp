@@ -56,6 +56,7 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
       cfg_.search_margin > 0 ? cfg_.search_margin : cfg_.thickness + 0.5 * (n_seg ? t_min : 1.0);
   inv_dt0_sq_ = 1.0 / (setup.dt * setup.dt);
 
+  seg_eroded_.assign(n_seg, 0);
   active_seg_.clear();
   for (std::size_t s = 0; s < n_seg; ++s) {
     const auto g = static_cast<std::size_t>(surf_.seg_group[s]);
@@ -125,6 +126,20 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
   dissipation_ = 0;
   stats_ = {};
   sort_segments(setup.x0);
+}
+
+void PenaltyContact::erode(const std::vector<std::int32_t>& mesh_hexes) {
+  std::vector<std::int32_t> gone(mesh_hexes);
+  std::sort(gone.begin(), gone.end());
+  bool any = false;
+  for (std::size_t s = 0; s < seg_eroded_.size(); ++s)
+    if (!seg_eroded_[s] && std::binary_search(gone.begin(), gone.end(), surf_.seg_hex[s]))
+      seg_eroded_[s] = 1, any = true;
+  if (!any) return;
+  std::erase_if(active_seg_, [&](std::int32_t s) { return seg_eroded_[static_cast<std::size_t>(s)] != 0; });
+  box_lo_.resize(3 * active_seg_.size());
+  box_hi_.resize(3 * active_seg_.size());
+  resort_ = true;
 }
 
 void PenaltyContact::block_frames(const double* x, const std::int32_t* seg, std::size_t n,
@@ -199,6 +214,7 @@ void PenaltyContact::sort_segments(const double* x) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t ng = n_groups_, n_node = surf_.n_nodes(), n_act = active_seg_.size();
   const double margin = margin_;
+  resort_ = false;
   // Frames of all segments, grown boxes of the active ones.
   for (std::size_t blk = 0; blk < frame_.size() / kFrameLanes; ++blk) compute_frames(x, blk);
   for (std::size_t a = 0; a < n_act; ++a) {
@@ -229,6 +245,7 @@ void PenaltyContact::sort_segments(const double* x) {
     int nf = 0;
     for (std::int32_t r = node_seg_start_[e]; r < node_seg_start_[e + 1]; ++r) {
       const auto q = static_cast<std::size_t>(node_seg_[static_cast<std::size_t>(r)]);
+      if (seg_eroded_[q]) continue;  // a node left without segments faces nothing
       const double* n = frame_[q].n;
       int best = -1;
       double best_dot = -2;
@@ -369,7 +386,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     }
     const double reach = 0.5 * (margin_ - cfg_.thickness);
     stats_.check_seconds += seconds(t0, Clock::now());
-    if (d2 > reach * reach) sort_segments(x);
+    if (resort_ || d2 > reach * reach) sort_segments(x);
   }
   const auto t1 = Clock::now();
 

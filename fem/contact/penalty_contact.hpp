@@ -77,6 +77,8 @@ class PenaltyContact final : public ContactAlgorithm {
   double friction_dissipation() const override { return dissipation_; }
   std::vector<ContactResultant> resultants() const override;
   std::int64_t active_contacts() const override { return stats_.n_active; }
+  /// Faces of eroded hexahedra leave the surface (faces they uncover are not added).
+  void erode(const std::vector<std::int32_t>& mesh_hexes) override;
 
   const PenaltyContactConfig& config() const { return cfg_; }
   const ContactSurface& surface() const { return surf_; }
@@ -146,6 +148,8 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<std::uint8_t> n_facets_;     // [n_snode]
   std::vector<std::int32_t> node_seg_start_, node_seg_;  // segments around each surface node (CSR)
   std::vector<std::int32_t> active_seg_;  // [n_seg] index into segs of the grid (active groups)
+  std::vector<std::uint8_t> seg_eroded_;  // [n_seg] 1: its hexahedron was eroded
+  bool resort_ = false;                   // the surface changed: sort before the next cycle
   BucketGrid grid_;
 
   ContactBatch batch_;          // active contacts on their way through the force kernel

@@ -123,6 +123,7 @@ void TiedContact::initialise(const ContactSetup& setup) {
     const double m_s = mass[3 * static_cast<std::size_t>(node)];
     node_.push_back(node);
     for (int a = 0; a < 4; ++a) corner_.push_back(surf.seg_nodes[4 * s + a]);
+    seg_hex_.push_back(surf.seg_hex[s]);
     xi_.push_back(bxi);
     eta_.push_back(beta);
     offset_.insert(offset_.end(), off, off + 3);
@@ -162,7 +163,7 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
     double crit = 0;
     if (normal_cap_[t] > 0) crit += (tension / normal_cap_[t]) * (tension / normal_cap_[t]);
     if (shear_cap_[t] > 0) crit += (shear / shear_cap_[t]) * (shear / shear_cap_[t]);
-    if (crit >= 1) {
+    if (crit >= 1 || alive_[t] == 2) {
       alive_[t] = 0;
       ++failed;
       released += 0.5 * k * d2;
@@ -179,6 +180,12 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
   n_alive_ -= failed;
   dissipation_ += released;
   force_ = {Rx, Ry, Rz};
+}
+
+void TiedContact::erode(const std::vector<std::int32_t>& mesh_hexes) {
+  for (std::size_t t = 0; t < node_.size(); ++t)
+    if (alive_[t] && std::find(mesh_hexes.begin(), mesh_hexes.end(), seg_hex_[t]) != mesh_hexes.end())
+      alive_[t] = 2;
 }
 
 std::vector<ContactResultant> TiedContact::resultants() const {

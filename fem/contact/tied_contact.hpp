@@ -29,6 +29,8 @@ class TiedContact final : public ContactAlgorithm {
   std::vector<ContactResultant> resultants() const override;
   /// Ties still holding.
   std::int64_t active_contacts() const override { return n_alive_; }
+  /// Ties on faces of eroded hexahedra fail in the next add_forces (their energy released).
+  void erode(const std::vector<std::int32_t>& mesh_hexes) override;
 
   const TiedContactConfig& config() const { return cfg_; }
   std::size_t n_ties() const { return node_.size(); }
@@ -46,7 +48,8 @@ class TiedContact final : public ContactAlgorithm {
   std::vector<double> stiffness_;     // [n_tie] k, N/m
   std::vector<double> normal_cap_;    // [n_tie] tensile strength * area, N (0: none)
   std::vector<double> shear_cap_;     // [n_tie] shear strength * area, N (0: none)
-  std::vector<std::uint8_t> alive_;   // [n_tie]
+  std::vector<std::int32_t> seg_hex_;  // [n_tie] hexahedron owning the master segment
+  std::vector<std::uint8_t> alive_;   // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
   std::int64_t n_alive_ = 0;
   double dissipation_ = 0;
   V3 force_;  // on the slave group, N

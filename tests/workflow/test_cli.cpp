@@ -73,6 +73,13 @@ TEST(Cli, SetOverridesAreCheckedLikeTheFile) {
   EXPECT_NE(r.output.find("'coarse'"), std::string::npos) << "should list the allowed values: " << r.output;
   r = run_cli({"check", c.string(), "--set", "mesh.resolution=coarse"});
   EXPECT_EQ(r.code, 0) << r.output;
+  for (const char* bad : {"time.erosion_step_ratio=1.0", "time.erosion_step_ratio=1e-5"}) {
+    r = run_cli({"check", c.string(), "--set", bad});
+    EXPECT_EQ(r.code, 2) << bad << ": " << r.output;
+    EXPECT_NE(r.output.find("time.erosion_step_ratio"), std::string::npos) << r.output;
+  }
+  r = run_cli({"check", c.string(), "--set", "time.erosion_step_ratio=0.3"});
+  EXPECT_EQ(r.code, 0) << r.output;
 }
 
 // Regression: the default case through the CLI reproduces Euler-Bernoulli within 5 %.

@@ -109,6 +109,16 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
     fr.fields.push_back(std::move(vm));
     fr.fields.push_back(std::move(fibre));
   }
+  if (nh && s.model().time.erosion_step_ratio > 0) {  // 1 where a hexahedron was eroded (threshold it away)
+    fem::io::FrameField eroded{"eroded", true, 1, std::vector<double>(nh + nb, 0.0)};
+    std::size_t o = 0;
+    for (const auto& b : s.hex_blocks()) {
+      if (b.n_eroded)
+        for (std::size_t e = 0; e < b.n; ++e) eroded.values[o + e] = b.eroded[e];
+      o += b.n;
+    }
+    fr.fields.push_back(std::move(eroded));
+  }
   if (nb) {
     fr.fields.push_back(std::move(axial));
     fr.fields.push_back(std::move(bstrain));
@@ -207,6 +217,11 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
                         "friction_energy_J", "damping_energy_J", "external_work_J", "total_energy_J",
                         "energy_balance_error"})
     hc.add(c);
+  const bool erosion = model.time.erosion_step_ratio > 0;
+  if (erosion) {
+    hc.add("eroded_elements");
+    hc.add("eroded_internal_energy_J");
+  }
   for (const auto& t : model.tools) {
     hc.add(t.name + "_force_N");
     hc.add(t.name + "_displacement_m");
@@ -337,6 +352,10 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     std::vector<double> row{solver.time(), static_cast<double>(solver.cycle()), solver.time_step(),
                             en.kinetic, en.internal, en.stabilisation, en.hourglass, en.contact,
                             en.friction, en.damping, en.external_work, en.total(), en.error()};
+    if (erosion) {
+      row.push_back(static_cast<double>(solver.erosions().size()));
+      row.push_back(en.eroded_internal);
+    }
     for (const auto& t : model.tools) {
       const V3 ax = tool_axis(t);
       row.push_back(-dot(t.force, ax));  // resistance of the part, positive against the motion
@@ -416,6 +435,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   std::string status = "completed";
   std::string failure;
   bool exceeded_reported = false;
+  std::size_t erosions_logged = 0;
   StopRequest::install();
   summary["status"] = "running";
   write_summary();
@@ -440,6 +460,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     summary["damping_energy_J"] = en.damping;
     summary["external_work_J"] = en.external_work;
     summary["hourglass_to_internal_ratio"] = en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
+    summary["eroded_elements"] = solver.erosions().size();
+    summary["eroded_internal_energy_J"] = en.eroded_internal;
     for (const auto& t : model.tools) {
       summary[t.name + "_force_N"] = -dot(t.force, tool_axis(t));
       summary[t.name + "_displacement_m"] = dot(t.displacement, tool_axis(t));
@@ -530,6 +552,17 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
       }
       solver.step([&] {
         const double t = solver.time();
+        for (; erosions_logged < solver.erosions().size(); ++erosions_logged) {
+          const auto& ev = solver.erosions()[erosions_logged];
+          const std::string why =
+              ev.cause == fem::ErosionEvent::Cause::InvertedCorner
+                  ? "a corner folded over (corner Jacobian <= 0)"
+                  : fmt::format("its step {:.3g} s fell below time.erosion_step_ratio = {:g} of the initial one",
+                                ev.step, tc.erosion_step_ratio);
+          log->warn("hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, {:.6g}) m: {}",
+                    ev.element, model.mesh.part_names[static_cast<std::size_t>(ev.part)], ev.time, ev.cycle,
+                    ev.centroid.x, ev.centroid.y, ev.centroid.z, why);
+        }
         const double err = solver.energy().error();
         if (t > 0.05 * tc.end_time) max_error = std::max(max_error, err);  // skip the start, when little energy is in play
         if (t >= next_history) {
