@@ -378,7 +378,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
           }
         } else {  // eroded lanes: at rest in the reference shape, so F = I and nothing moves
           bool d[W];
-          for (int l = 0; l < W; ++l) d[l] = dead[e + static_cast<std::size_t>(l < cnt ? l : cnt - 1)] != 0;
+          for (int l = 0; l < W; ++l)
+            d[l] = dead[e + static_cast<std::size_t>(l < cnt ? l : cnt - 1)] != 0;
           for (int c = 0; c < 3; ++c) {
             xu[c][I] = VD([&](auto l) { return (d[l] ? x_ref : x)[idx[l] + c]; });
             vu[c][I] = VD([&](auto l) { return d[l] ? 0.0 : v[idx[l] + c]; });

@@ -288,7 +288,8 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
   auto centre = [&](const std::int32_t* conn, std::size_t stride, std::size_t e, int nn) {
     V3 c;
     for (int I = 0; I < nn; ++I)
-      c += (1.0 / nn) * V3::at(x + 3 * static_cast<std::size_t>(conn[static_cast<std::size_t>(I) * stride + e]));
+      c += (1.0 / nn) *
+           V3::at(x + 3 * static_cast<std::size_t>(conn[static_cast<std::size_t>(I) * stride + e]));
     std::ostringstream os;
     os << "(" << c.x << ", " << c.y << ", " << c.z << ") m";
     return os.str();
@@ -320,8 +321,17 @@ StableStep ExplicitSolver::erode(const double* x, double dt_erode) {
         continue;
       }
       using Cause = ErosionEvent::Cause;
-      ErosionEvent ev{folded ? Cause::InvertedCorner : Cause::StableStep, t_, cycle_, b.user_id[e], b.part, sf * dt, {}};
-      for (int I = 0; I < 8; ++I) ev.centroid += 0.125 * V3::at(x + 3 * static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * b.n + e]));
+      ErosionEvent ev{folded ? Cause::InvertedCorner : Cause::StableStep,
+                      t_,
+                      cycle_,
+                      b.user_id[e],
+                      b.part,
+                      sf * dt,
+                      {}};
+      for (int I = 0; I < 8; ++I)
+        ev.centroid +=
+            0.125 *
+            V3::at(x + 3 * static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * b.n + e]));
       energy_.eroded_internal += hex8_erode(b, e);
       gone.push_back(b.mesh_hex[e]);
       erosions_.push_back(ev);
@@ -462,12 +472,14 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   StableStep st;
   {
     auto X0 = x0.view();
-    for (auto& b : hex_) hex8_internal_forces(b, X.data(), Vv.data(), dt_prev_, fi, inc, st, X0.data());
+    for (auto& b : hex_)
+      hex8_internal_forces(b, X.data(), Vv.data(), dt_prev_, fi, inc, st, X0.data());
   }
   // Erosion: a step below the limit is seen at once; folded corners, which develop over many
   // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
   const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
-  if (dt_erode > 0 && (model_.time.safety_factor * st.dt < dt_erode || cycle_ % kFoldCheckInterval == 0))
+  if (dt_erode > 0 &&
+      (model_.time.safety_factor * st.dt < dt_erode || cycle_ % kFoldCheckInterval == 0))
     st = erode(X.data(), dt_erode);
   for (auto& b : bar_) bar_internal_forces(b, X.data(), fi, inc, st);
   energy_.internal += inc.internal;
@@ -510,7 +522,8 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     os << "numerical instability: the stable time step fell to " << dt_new << " s ("
        << dt_new / dt_initial_ << " of the initial " << dt_initial_ << " s) at t = " << t_
        << " s, cycle " << cycle_ << "; controlled by " << (st.is_bar ? "bar " : "hexahedron ")
-       << st.element << " at " << element_position(st, X.data()) << " (severely distorted or inverted)";
+       << st.element << " at " << element_position(st, X.data())
+       << " (severely distorted or inverted)";
     throw NumericalError(os.str());
   }
 

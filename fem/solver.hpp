@@ -30,8 +30,8 @@ struct ErosionEvent {
   std::int64_t cycle = 0;
   std::int64_t element = 0;  // user id
   int part = 0;
-  double step = 0;           // its stable step when eroded (times the safety factor), s
-  V3 centroid;               // m
+  double step = 0;  // its stable step when eroded (times the safety factor), s
+  V3 centroid;      // m
 };
 
 struct PhaseTimers {

@@ -136,7 +136,8 @@ void PenaltyContact::erode(const std::vector<std::int32_t>& mesh_hexes) {
     if (!seg_eroded_[s] && std::binary_search(gone.begin(), gone.end(), surf_.seg_hex[s]))
       seg_eroded_[s] = 1, any = true;
   if (!any) return;
-  std::erase_if(active_seg_, [&](std::int32_t s) { return seg_eroded_[static_cast<std::size_t>(s)] != 0; });
+  std::erase_if(active_seg_,
+                [&](std::int32_t s) { return seg_eroded_[static_cast<std::size_t>(s)] != 0; });
   box_lo_.resize(3 * active_seg_.size());
   box_hi_.resize(3 * active_seg_.size());
   resort_ = true;

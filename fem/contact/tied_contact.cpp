@@ -184,7 +184,8 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
 
 void TiedContact::erode(const std::vector<std::int32_t>& mesh_hexes) {
   for (std::size_t t = 0; t < node_.size(); ++t)
-    if (alive_[t] && std::find(mesh_hexes.begin(), mesh_hexes.end(), seg_hex_[t]) != mesh_hexes.end())
+    if (alive_[t] &&
+        std::find(mesh_hexes.begin(), mesh_hexes.end(), seg_hex_[t]) != mesh_hexes.end())
       alive_[t] = 2;
 }
 

@@ -49,7 +49,7 @@ class TiedContact final : public ContactAlgorithm {
   std::vector<double> normal_cap_;    // [n_tie] tensile strength * area, N (0: none)
   std::vector<double> shear_cap_;     // [n_tie] shear strength * area, N (0: none)
   std::vector<std::int32_t> seg_hex_;  // [n_tie] hexahedron owning the master segment
-  std::vector<std::uint8_t> alive_;   // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
+  std::vector<std::uint8_t> alive_;    // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
   std::int64_t n_alive_ = 0;
   double dissipation_ = 0;
   V3 force_;  // on the slave group, N

@@ -23,8 +23,8 @@ struct Rig {
 std::unique_ptr<Rig> rig(double force) {
   auto r = std::make_unique<Rig>();
   test::add_elastic_block(r->model, "lower", {0, 0, 0}, {kL, kL, kL}, {1, 1, 1}, kRho, kE, 0.3);
-  test::add_elastic_block(r->model, "upper", {0.25 * kL, 0.25 * kL, kL}, {0.5 * kL, 0.5 * kL, 0.25 * kL},
-                          {2, 2, 1}, kRho, kE, 0.3);
+  test::add_elastic_block(r->model, "upper", {0.25 * kL, 0.25 * kL, kL},
+                          {0.5 * kL, 0.5 * kL, 0.25 * kL}, {2, 2, 1}, kRho, kE, 0.3);
   r->model.fixed.push_back({"base", test::nodes_at(r->model.mesh, 2, 0.0), {true, true, true}});
   r->upper = test::part_nodes(r->model.mesh, 1);
   fem::NodalLoad ld;
@@ -55,7 +55,8 @@ TEST(ContactErosion, PenaltySurfaceOfAnErodedElementHoldsNothing) {
   run_to(solver, 3e-3);
   ASSERT_GT(contact->active_contacts(), 0);
   const double a = r->force / r->upper_mass, t0 = solver.time();
-  EXPECT_LT(std::abs(test::mean_of(solver, r->upper, 2, 1)), 0.01 * std::abs(a) * 1e-3) << "at rest before";
+  EXPECT_LT(std::abs(test::mean_of(solver, r->upper, 2, 1)), 0.01 * std::abs(a) * 1e-3)
+      << "at rest before";
 
   contact->erode({0});  // the lower cube
   const double v0 = test::mean_of(solver, r->upper, 2, 1);

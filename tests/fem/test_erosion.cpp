@@ -34,7 +34,7 @@ TEST(HexErosion, CrushedElementIsErodedAtTheStepRatio) {
   fem::ExplicitSolver solver(model);
   const double sf = model.time.safety_factor, dt0 = solver.time_step();
   const double M = kE * (1 - kNu) / ((1 + kNu) * (1 - 2 * kNu));  // lambda + 2 mu
-  const double c = std::sqrt(kE / (1 - 2 * kNu) / kRho);            // the step's modulus 3K
+  const double c = std::sqrt(kE / (1 - 2 * kNu) / kRho);          // the step's modulus 3K
   ASSERT_TRUE(test::near_rel(dt0, sf * kH / c, 1e-12));
   const double t_e = (1 - kRatio) * kH / kV;
   double internal_before = 0, reaction_before = 0, t_before = 0;
@@ -46,7 +46,8 @@ TEST(HexErosion, CrushedElementIsErodedAtTheStepRatio) {
       t_before = solver.time();
     });
   }
-  ASSERT_EQ(solver.erosions().size(), 1u) << "the crushed cube was not eroded by t = " << solver.time();
+  ASSERT_EQ(solver.erosions().size(), 1u)
+      << "the crushed cube was not eroded by t = " << solver.time();
   const auto& ev = solver.erosions()[0];
   EXPECT_EQ(ev.element, model.mesh.hex_user_id[0]);
   EXPECT_NEAR(ev.time, t_e, 2 * dt0) << "eroded when h_A / h = " << 1 - kV * ev.time / kH;
@@ -64,7 +65,8 @@ TEST(HexErosion, CrushedElementIsErodedAtTheStepRatio) {
   EXPECT_EQ(r.x, 0.0);
   EXPECT_EQ(r.y, 0.0);
   EXPECT_EQ(r.z, 0.0);
-  EXPECT_TRUE(test::near_rel(solver.time_step(), sf * kH / c, 1e-3)) << "the step is the upper cube's again";
+  EXPECT_TRUE(test::near_rel(solver.time_step(), sf * kH / c, 1e-3))
+      << "the step is the upper cube's again";
   EXPECT_EQ(solver.erosions().size(), 1u);
   EXPECT_LT(solver.energy().error(), 1e-3);
 }

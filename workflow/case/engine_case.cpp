@@ -626,7 +626,8 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
   time.energy_balance_limit = tc.number("energy_balance_limit", 0.05, Range::open_closed(0, 1));
   time.erosion_step_ratio = tc.number("erosion_step_ratio", 0.0, Range{0, 1, false, true});
   if (time.erosion_step_ratio > 0 && time.erosion_step_ratio <= time.min_step_ratio)
-    tc.fail("erosion_step_ratio", "must be 0 (off) or above " + std::to_string(time.min_step_ratio) +
+    tc.fail("erosion_step_ratio", "must be 0 (off) or above " +
+                                      std::to_string(time.min_step_ratio) +
                                       ", the share of the initial step at which a run stops");
   for (std::size_t k = 0; k < ec.model.picture_frames.size(); ++k) {  // constant rate to the final angle at end_time
     auto& pf = ec.model.picture_frames[k];

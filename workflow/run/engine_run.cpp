@@ -109,7 +109,8 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
     fr.fields.push_back(std::move(vm));
     fr.fields.push_back(std::move(fibre));
   }
-  if (nh && s.model().time.erosion_step_ratio > 0) {  // 1 where a hexahedron was eroded (threshold it away)
+  if (nh && s.model().time.erosion_step_ratio >
+                0) {  // 1 where a hexahedron was eroded (threshold it away)
     fem::io::FrameField eroded{"eroded", true, 1, std::vector<double>(nh + nb, 0.0)};
     std::size_t o = 0;
     for (const auto& b : s.hex_blocks()) {
@@ -554,14 +555,17 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
         const double t = solver.time();
         for (; erosions_logged < solver.erosions().size(); ++erosions_logged) {
           const auto& ev = solver.erosions()[erosions_logged];
-          const std::string why =
-              ev.cause == fem::ErosionEvent::Cause::InvertedCorner
-                  ? "a corner folded over (corner Jacobian <= 0)"
-                  : fmt::format("its step {:.3g} s fell below time.erosion_step_ratio = {:g} of the initial one",
-                                ev.step, tc.erosion_step_ratio);
-          log->warn("hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, {:.6g}) m: {}",
-                    ev.element, model.mesh.part_names[static_cast<std::size_t>(ev.part)], ev.time, ev.cycle,
-                    ev.centroid.x, ev.centroid.y, ev.centroid.z, why);
+          const std::string why = ev.cause == fem::ErosionEvent::Cause::InvertedCorner
+                                      ? "a corner folded over (corner Jacobian <= 0)"
+                                      : fmt::format(
+                                            "its step {:.3g} s fell below time.erosion_step_ratio "
+                                            "= {:g} of the initial one",
+                                            ev.step, tc.erosion_step_ratio);
+          log->warn(
+              "hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, "
+              "{:.6g}) m: {}",
+              ev.element, model.mesh.part_names[static_cast<std::size_t>(ev.part)], ev.time,
+              ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z, why);
         }
         const double err = solver.energy().error();
         if (t > 0.05 * tc.end_time) max_error = std::max(max_error, err);  // skip the start, when little energy is in play
