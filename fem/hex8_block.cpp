@@ -371,18 +371,17 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         const std::int32_t* ci = conn + I * n + e;
         std::size_t idx[W];
         for (int l = 0; l < W; ++l) idx[l] = 3 * static_cast<std::size_t>(ci[l < cnt ? l : cnt - 1]);
-        if (!dead) {
-          for (int c = 0; c < 3; ++c) {
-            xu[c][I] = VD([&](auto l) { return x[idx[l] + c]; });
-            vu[c][I] = VD([&](auto l) { return v[idx[l] + c]; });
-          }
-        } else {  // eroded lanes: at rest in the reference shape, so F = I and nothing moves
-          bool d[W];
-          for (int l = 0; l < W; ++l)
-            d[l] = dead[e + static_cast<std::size_t>(l < cnt ? l : cnt - 1)] != 0;
-          for (int c = 0; c < 3; ++c) {
-            xu[c][I] = VD([&](auto l) { return (d[l] ? x_ref : x)[idx[l] + c]; });
-            vu[c][I] = VD([&](auto l) { return d[l] ? 0.0 : v[idx[l] + c]; });
+        for (int c = 0; c < 3; ++c) {
+          xu[c][I] = VD([&](auto l) { return x[idx[l] + c]; });
+          vu[c][I] = VD([&](auto l) { return v[idx[l] + c]; });
+        }
+      }
+      if (dead) {  // eroded lanes: at rest in the reference shape, so F = I and nothing moves
+        for (int l = 0; l < cnt; ++l) {
+          if (!dead[e + static_cast<std::size_t>(l)]) continue;
+          for (int I = 0; I < 8; ++I) {
+            const std::size_t i = 3 * static_cast<std::size_t>(conn[I * n + e + static_cast<std::size_t>(l)]);
+            for (int c = 0; c < 3; ++c) xu[c][I][l] = x_ref[i + c], vu[c][I][l] = 0.0;
           }
         }
       }
@@ -504,12 +503,12 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       store(b.volume.data() + e, V, cnt);
       const VD V0 = load(vol0 + e, cnt);
       VD sm[6], wint = 0.0;
-      batch::VD::mask_type is_dead(false);
-      if (dead)
-        for (int l = 0; l < cnt; ++l) is_dead[l] = dead[e + static_cast<std::size_t>(l)] != 0;
+      for (int c = 0; c < 6; ++c) sm[c] = load(stress + c * n + e, cnt);
+      if (dead)  // an eroded element carries no stress, whatever its material made of no strain
+        for (int l = 0; l < cnt; ++l)
+          if (dead[e + static_cast<std::size_t>(l)])
+            for (VD& s : sm) s[l] = 0.0;
       for (int c = 0; c < 6; ++c) {
-        sm[c] = load(stress + c * n + e, cnt);
-        stdx::where(is_dead, sm[c]) = 0.0;  // whatever the material did with a zero increment
         const VD de = load_a(&deps[c][j]);
         wint += 0.5 * (sm[c] + load_a(&sig_old[c][j])) * de;
         store(strain + c * n + e, load(strain + c * n + e, cnt) + de, cnt);
