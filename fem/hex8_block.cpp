@@ -380,7 +380,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         for (int l = 0; l < cnt; ++l) {
           if (!dead[e + static_cast<std::size_t>(l)]) continue;
           for (int I = 0; I < 8; ++I) {
-            const std::size_t i = 3 * static_cast<std::size_t>(conn[I * n + e + static_cast<std::size_t>(l)]);
+            const std::size_t i =
+                3 * static_cast<std::size_t>(conn[I * n + e + static_cast<std::size_t>(l)]);
             for (int c = 0; c < 3; ++c) xu[c][I][l] = x_ref[i + c], vu[c][I][l] = 0.0;
           }
         }
