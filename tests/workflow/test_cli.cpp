@@ -275,6 +275,8 @@ nlohmann::json run_bias_extension(const std::string& sign) {
 void check_shear_against_eq2(const nlohmann::json& s) {
   EXPECT_EQ(s["status"], "completed");
   EXPECT_LT(s["energy_balance_error"].get<double>(), 0.01);
+  // Erosion is there for a few folded tow ends at the clamp corners, not to carry a failing run.
+  EXPECT_LE(s["eroded_elements"].get<int>(), 8);
   for (int d : {5, 10}) {
     const std::string k = "_at_" + std::to_string(d) + "mm";
     EXPECT_NEAR(s["shear_angle_deg" + k].get<double>(), s["analytic_shear_angle_deg" + k].get<double>(), 3.0) << d << " mm";
