@@ -187,11 +187,17 @@ void hex8_lumped_mass(const Hex8Block& b, double* mass) {
   }
 }
 
-void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt) {
+void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt,
+                        std::vector<double>* corner_jacobian) {
+  // The three edges leaving each corner, right-handed (bottom face 0-3, top 4-7 above them).
+  constexpr int kEdges[8][3] = {{1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7},
+                                {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}};
   dt.resize(b.n);
+  if (corner_jacobian) corner_jacobian->resize(b.n);
   for (std::size_t e = 0; e < b.n; ++e) {
     if (b.n_eroded && b.eroded[e]) {
       dt[e] = 1e300;
+      if (corner_jacobian) (*corner_jacobian)[e] = 1.0;
       continue;
     }
     Vec3 xe[8];
@@ -200,27 +206,13 @@ void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>
     hex_geometry(xe, g);
     const double lc = g.V / std::sqrt(max_face_area_sq(xe));
     dt[e] = lc / std::sqrt(b.p_modulus / b.density[e]);
-  }
-}
-
-void hex8_corner_jacobians(const Hex8Block& b, const double* x, std::vector<double>& jmin) {
-  // The three edges leaving each corner, right-handed (bottom face 0-3, top 4-7 above them).
-  constexpr int kEdges[8][3] = {{1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7},
-                                {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}};
-  jmin.resize(b.n);
-  for (std::size_t e = 0; e < b.n; ++e) {
-    if (b.n_eroded && b.eroded[e]) {
-      jmin[e] = 1.0;
-      continue;
-    }
-    Vec3 xe[8];
-    gather(b, e, x, xe);
+    if (!corner_jacobian) continue;
     double j = 1e300;
     for (int c = 0; c < 8; ++c) {
       const Vec3 o = xe[c];
       j = std::min(j, dot(cross(xe[kEdges[c][0]] - o, xe[kEdges[c][1]] - o), xe[kEdges[c][2]] - o));
     }
-    jmin[e] = j / b.volume0[e];
+    (*corner_jacobian)[e] = j / b.volume0[e];
   }
 }
 

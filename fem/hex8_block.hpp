@@ -65,14 +65,13 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
 void hex8_lumped_mass(const Hex8Block& b, double* mass);
 
 /// Stable time step of every element (characteristic length V/A_max over wave speed); an eroded
-/// element has none (1e300).
+/// element has none (1e300). With `corner_jacobian`, also the smallest corner Jacobian of each
+/// element (the triple product of the three edges leaving a corner, over the reference volume; 1
+/// for an undistorted box, <= 0 where the element folds over at that corner, which the one-point
+/// volume does not see; 1 for an eroded element).
 StableStep hex8_stable_step(const Hex8Block& b, const double* x);
-void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt);
-
-/// Smallest corner Jacobian of each element at x (the triple product of the three edges leaving a
-/// corner, over the reference volume; 1 for an undistorted box, <= 0 where the element folds over
-/// at that corner, which the one-point volume does not see). Eroded elements get 1.
-void hex8_corner_jacobians(const Hex8Block& b, const double* x, std::vector<double>& jmin);
+void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt,
+                        std::vector<double>* corner_jacobian = nullptr);
 
 /// Erodes element e: from now on it adds no force, no energy and no step limit; its nodes keep
 /// their mass. Returns the elastic energy it held, 1/2 S:E V0 (exact for a linear law in

@@ -311,8 +311,7 @@ StableStep ExplicitSolver::erode(const double* x, double dt_erode) {
   std::vector<std::int32_t> gone;
   StableStep left;
   for (auto& b : hex_) {
-    hex8_element_steps(b, x, step_scratch_);
-    hex8_corner_jacobians(b, x, jacobian_scratch_);
+    hex8_element_steps(b, x, step_scratch_, &jacobian_scratch_);
     for (std::size_t e = 0; e < b.n; ++e) {
       const double dt = step_scratch_[e];
       const bool folded = !(jacobian_scratch_[e] > 0);
