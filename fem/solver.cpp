@@ -11,6 +11,14 @@ namespace ncfsim::fem {
 namespace {
 using Clock = std::chrono::steady_clock;
 constexpr std::int64_t kFoldCheckInterval = 10;  // cycles between searches for folded hexahedra
+// Centroid at x of element e of a block with nn nodes per element, connectivity [nn][stride].
+V3 centroid(const std::int32_t* conn, std::size_t stride, std::size_t e, int nn, const double* x) {
+  V3 c;
+  for (int I = 0; I < nn; ++I)
+    c += (1.0 / nn) *
+         V3::at(x + 3 * static_cast<std::size_t>(conn[static_cast<std::size_t>(I) * stride + e]));
+  return c;
+}
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -286,10 +294,7 @@ void ExplicitSolver::apply_mass_scaling() {
 
 std::string ExplicitSolver::element_position(const StableStep& st, const double* x) const {
   auto centre = [&](const std::int32_t* conn, std::size_t stride, std::size_t e, int nn) {
-    V3 c;
-    for (int I = 0; I < nn; ++I)
-      c += (1.0 / nn) *
-           V3::at(x + 3 * static_cast<std::size_t>(conn[static_cast<std::size_t>(I) * stride + e]));
+    const V3 c = centroid(conn, stride, e, nn, x);
     std::ostringstream os;
     os << "(" << c.x << ", " << c.y << ", " << c.z << ") m";
     return os.str();
@@ -320,17 +325,13 @@ StableStep ExplicitSolver::erode(const double* x, double dt_erode) {
         continue;
       }
       using Cause = ErosionEvent::Cause;
-      ErosionEvent ev{folded ? Cause::InvertedCorner : Cause::StableStep,
-                      t_,
-                      cycle_,
-                      b.user_id[e],
-                      b.part,
-                      sf * dt,
-                      {}};
-      for (int I = 0; I < 8; ++I)
-        ev.centroid +=
-            0.125 *
-            V3::at(x + 3 * static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * b.n + e]));
+      const ErosionEvent ev{folded ? Cause::InvertedCorner : Cause::StableStep,
+                            t_,
+                            cycle_,
+                            b.user_id[e],
+                            b.part,
+                            sf * dt,
+                            centroid(b.conn.data(), b.n, e, 8, x)};
       energy_.eroded_internal += hex8_erode(b, e);
       gone.push_back(b.mesh_hex[e]);
       erosions_.push_back(ev);
