@@ -216,6 +216,46 @@ void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>
   }
 }
 
+void hex8_element_force(const Hex8Block& b, std::size_t e, const double* x, const double* v,
+                        double f[24]) {
+  // A one-element copy of the block on local nodes 0..7, through the batched kernel.
+  Hex8Block one;
+  one.part = b.part;
+  one.material = b.material;
+  one.n = 1;
+  one.hourglass_stiffness = b.hourglass_stiffness;
+  one.hourglass_viscosity = b.hourglass_viscosity;
+  one.p_modulus = b.p_modulus;
+  auto take = [&](const std::vector<double>& from, std::vector<double>& to) {
+    const std::size_t rows = b.n ? from.size() / b.n : 0;
+    to.resize(rows);
+    for (std::size_t r = 0; r < rows; ++r) to[r] = from[r * b.n + e];
+  };
+  take(b.stress, one.stress);
+  take(b.strain, one.strain);
+  take(b.history, one.history);
+  take(b.hg_force, one.hg_force);
+  take(b.mat_axes, one.mat_axes);
+  take(b.jac_inv0, one.jac_inv0);
+  take(b.jac_inv0_axes, one.jac_inv0_axes);
+  take(b.hg_moduli, one.hg_moduli);
+  take(b.volume, one.volume);
+  take(b.volume0, one.volume0);
+  take(b.density, one.density);
+  one.user_id = {b.user_id[e]};
+  one.conn = {0, 1, 2, 3, 4, 5, 6, 7};
+  double xl[24], vl[24];
+  for (int I = 0; I < 8; ++I) {
+    const auto node = static_cast<std::size_t>(b.conn[static_cast<std::size_t>(I) * b.n + e]);
+    for (int c = 0; c < 3; ++c) xl[3 * I + c] = x[3 * node + c], vl[3 * I + c] = v[3 * node + c];
+  }
+  std::fill(f, f + 24, 0.0);
+  ElementEnergyIncrement inc;
+  StableStep st;
+  hex8_internal_forces(one, xl, vl, 0.0, f, inc, st);
+  for (int k = 0; k < 24; ++k) f[k] = -f[k];  // the kernel subtracts internal forces
+}
+
 double hex8_erode(Hex8Block& b, std::size_t e) {
   const std::size_t n = b.n;
   if (b.eroded.empty()) b.eroded.assign(n, 0);

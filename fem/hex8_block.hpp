@@ -73,6 +73,13 @@ StableStep hex8_stable_step(const Hex8Block& b, const double* x);
 void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt,
                         std::vector<double>* corner_jacobian = nullptr);
 
+/// Nodal internal forces f[8][3] (VTK node order of element e) that element e exerts on its
+/// nodes at positions x with velocities v, from its current state: what hex8_internal_forces
+/// adds for it with a zero step (stress and stabilisation as they stand, viscous hourglass part
+/// from v). The block is not changed.
+void hex8_element_force(const Hex8Block& b, std::size_t e, const double* x, const double* v,
+                        double f[24]);
+
 /// Erodes element e: from now on it adds no force, no energy and no step limit; its nodes keep
 /// their mass. Returns the elastic energy it held, 1/2 S:E V0 (exact for a linear law in
 /// Green-Lagrange strain), which leaves the model with it.

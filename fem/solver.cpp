@@ -311,7 +311,7 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
   return "(unknown position)";
 }
 
-StableStep ExplicitSolver::erode(const double* x, double dt_erode) {
+StableStep ExplicitSolver::erode(const double* x, const double* v, double dt_erode) {
   const double sf = model_.time.safety_factor;
   std::vector<std::int32_t> gone;
   StableStep left;
@@ -332,6 +332,9 @@ StableStep ExplicitSolver::erode(const double* x, double dt_erode) {
                             b.part,
                             sf * dt,
                             centroid(b.conn.data(), b.n, e, 8, x)};
+      ErodedForce& ef = eroded_forces_.emplace_back();
+      for (int I = 0; I < 8; ++I) ef.node[I] = b.conn[static_cast<std::size_t>(I) * b.n + e];
+      hex8_element_force(b, e, x, v, ef.f);
       energy_.eroded_internal += hex8_erode(b, e);
       gone.push_back(b.mesh_hex[e]);
       erosions_.push_back(ev);
@@ -480,7 +483,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
   if (dt_erode > 0 &&
       (model_.time.safety_factor * st.dt < dt_erode || cycle_ % kFoldCheckInterval == 0))
-    st = erode(X.data(), dt_erode);
+    st = erode(X.data(), Vv.data(), dt_erode);
   for (auto& b : bar_) bar_internal_forces(b, X.data(), fi, inc, st);
   energy_.internal += inc.internal;
   energy_.stabilisation += inc.stabilisation;
@@ -589,6 +592,12 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     ke += 0.5 * m * vo * dv;
   }
   w_ext_.add(ext_old, ext_new);
+  for (const auto& ef : eroded_forces_)  // see ErodedForce
+    for (int I = 0; I < 8; ++I)
+      for (int c = 0; c < 3; ++c)
+        energy_.internal +=
+            0.5 * ef.f[3 * I + c] * dt_new * vel[3 * static_cast<std::size_t>(ef.node[I]) + c];
+  eroded_forces_.clear();
   w_damp_.add(damp_old, damp_new);
   w_contact_nodes_.add(con_old, con_new);
 

@@ -85,7 +85,7 @@ class ExplicitSolver {
   /// Erodes every hexahedron whose step at x (times the safety factor) is below dt_erode or
   /// one of whose corners has folded over (corner Jacobian <= 0); returns the stable step of
   /// those left.
-  StableStep erode(const double* x, double dt_erode);
+  StableStep erode(const double* x, const double* v, double dt_erode);
   /// "(x, y, z) m": centroid at x of the element a StableStep names (for messages).
   std::string element_position(const StableStep& st, const double* x) const;
 
@@ -95,6 +95,14 @@ class ExplicitSolver {
   std::vector<PartMassReport> part_mass_;
   std::vector<ErosionEvent> erosions_;
   std::vector<double> step_scratch_, jacobian_scratch_;
+  /// Elements eroded this cycle: their nodes and nodal internal forces at t^n. Their work over the
+  /// first half of the next increment, which the trapezoidal external work counts, is booked
+  /// as internal energy once the increment is known (the element no longer does it).
+  struct ErodedForce {
+    std::int32_t node[8];
+    double f[24];
+  };
+  std::vector<ErodedForce> eroded_forces_;
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
   std::vector<V3> vpres_;

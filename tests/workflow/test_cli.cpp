@@ -161,6 +161,33 @@ TEST(CliRegression, InterruptedRunLeavesReadableResults) {
 
 // `ncfsim calibrate stitch` round trip: synthetic bias-extension data (mm, irregular) made with a
 // known 'Lambda' stitch law through the Eq. 2-6 model give that law back within 5 %.
+// Erosion through the command line (tests/cases/erosion/crushed_cube.toml): a cube crushed in
+// uniaxial strain at 0.5 m/s is eroded when half as high (t = 10 ms, within a step of 0.1 ms);
+// the run completes, the log names the element and the cause, summary.json counts it and its
+// elastic energy, history.csv gets the eroded count from then on, and the frames an 'eroded' field.
+TEST(Cli, ErosionIsReportedEverywhere) {
+  const fs::path out = fresh_dir("erosion");
+  const Result r = run_cli({"run", (kSource / "tests/cases/erosion/crushed_cube.toml").string(),
+                            "-o", out.string(), "--set", "output.figures=false"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("hexahedron 1 (part cube) eroded at t = 0.01"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("time.erosion_step_ratio = 0.5"), std::string::npos) << r.output;
+  const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_EQ(s["status"], "completed");
+  EXPECT_EQ(s["eroded_elements"].get<int>(), 1);
+  EXPECT_GT(s["eroded_internal_energy_J"].get<double>(), 0.0);
+  EXPECT_LT(s["energy_balance_error"].get<double>(), 0.002);
+  const History h = read_history(out / "history.csv");
+  const std::size_t t = h.column("time"), n = h.column("eroded_elements");
+  ASSERT_LT(n, h.columns.size());
+  ASSERT_LT(h.column("eroded_internal_energy_J"), h.columns.size());
+  for (const auto& row : h.rows)
+    EXPECT_EQ(row[n], row[t] < 0.0099 ? 0.0 : row[t] > 0.0102 ? 1.0 : row[n]) << row[t];
+  EXPECT_NE(slurp(out / "results.xdmf").find("Name=\"eroded\""), std::string::npos);
+  fs::remove_all(out);
+}
+
 TEST(Cli, CalibrateStitchRoundTrip) {
   const fs::path dir = fresh_dir("calibrate");
   fs::create_directories(dir);

@@ -109,8 +109,8 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
     fr.fields.push_back(std::move(vm));
     fr.fields.push_back(std::move(fibre));
   }
-  if (nh && s.model().time.erosion_step_ratio >
-                0) {  // 1 where a hexahedron was eroded (threshold it away)
+  if (nh && s.model().time.erosion_step_ratio > 0) {
+    // 1 where a hexahedron was eroded (ParaView: threshold it away)
     fem::io::FrameField eroded{"eroded", true, 1, std::vector<double>(nh + nb, 0.0)};
     std::size_t o = 0;
     for (const auto& b : s.hex_blocks()) {
