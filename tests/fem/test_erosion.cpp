@@ -85,7 +85,7 @@ TEST(HexErosion, CrushedElementIsErodedAtTheStepRatio) {
 // plane of the base. The one-point volume stays positive (7/8 of the cube's when the corner reaches
 // the base) and the step hardly changes, but the corner Jacobian at that corner and at the base
 // corner below it is h_corner a^2 and vanishes when the corner reaches the base, at t_f = h / v;
-// the element must be eroded for its folded corner within the 10 cycles between searches.
+// the element must be eroded for its folded corner within the 50 cycles between searches.
 TEST(HexErosion, FoldedCornerIsEroded) {
   fem::Model model;
   test::add_elastic_block(model, "cube", {0, 0, 0}, {kH, kH, kH}, {1, 1, 1}, kRho, kE, kNu);
@@ -113,6 +113,6 @@ TEST(HexErosion, FoldedCornerIsEroded) {
   const auto& ev = solver.erosions()[0];
   EXPECT_EQ(ev.cause, fem::ErosionEvent::Cause::InvertedCorner);
   EXPECT_GE(ev.time, t_f * (1 - 1e-9));
-  EXPECT_LE(ev.time, t_f + 11 * solver.time_step());
+  EXPECT_LE(ev.time, t_f + 51 * solver.time_step());
   EXPECT_GT(ev.step, 0.1 * solver.time_step()) << "the step criterion must not be what fired";
 }
