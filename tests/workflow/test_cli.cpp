@@ -164,7 +164,8 @@ TEST(CliRegression, InterruptedRunLeavesReadableResults) {
 // Erosion through the command line (tests/cases/erosion/crushed_cube.toml): a cube crushed in
 // uniaxial strain at 0.5 m/s is eroded when half as high (t = 10 ms, within a step of 0.1 ms);
 // the run completes, the log names the element and the cause, summary.json counts it and its
-// elastic energy, history.csv gets the eroded count from then on, and the frames an 'eroded' field.
+// elastic energy, history.csv gets the eroded count from then on, a shear probe leaves it out, and
+// the frames get an 'eroded' field.
 TEST(Cli, ErosionIsReportedEverywhere) {
   const fs::path out = fresh_dir("erosion");
   const Result r = run_cli({"run", (kSource / "tests/cases/erosion/crushed_cube.toml").string(),
@@ -184,6 +185,17 @@ TEST(Cli, ErosionIsReportedEverywhere) {
   ASSERT_LT(h.column("eroded_internal_energy_J"), h.columns.size());
   for (const auto& row : h.rows)
     EXPECT_EQ(row[n], row[t] < 0.0099 ? 0.0 : row[t] > 0.0102 ? 1.0 : row[n]) << row[t];
+  // The shear probe over the crushed cube and its untouched neighbour (parallel axes: 90 deg)
+  // measures until the crushed cube is gone, then has nothing to measure.
+  const std::size_t p = h.column("pair_shear_angle_deg");
+  ASSERT_LT(p, h.columns.size());
+  for (const auto& row : h.rows) {
+    if (row[t] < 0.0099) {
+      EXPECT_NEAR(row[p], 90.0, 1e-6) << row[t];
+    } else if (row[t] > 0.0102) {
+      EXPECT_TRUE(std::isnan(row[p])) << row[t] << ": " << row[p];
+    }
+  }
   EXPECT_NE(slurp(out / "results.xdmf").find("Name=\"eroded\""), std::string::npos);
   fs::remove_all(out);
 }

@@ -286,15 +286,19 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     auto mean = [&](const std::vector<std::pair<std::size_t, std::size_t>>& set) {
       V3 s, first;
       for (const auto& [k, e] : set) {
+        const auto& b = solver.hex_blocks()[k];
+        if (b.n_eroded && b.eroded[e]) continue;  // no longer part of the fabric
         double d[3];
-        fem::hex8_fibre_direction(solver.hex_blocks()[k], X.data(), e, d);
+        fem::hex8_fibre_direction(b, X.data(), e, d);
         V3 v{d[0], d[1], d[2]};
         if (norm(first) == 0) first = v;
         s += dot(v, first) < 0 ? -1.0 * v : v;  // a fibre direction has no sign
       }
-      return normalized(s);
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      return norm(s) > 0 ? normalized(s) : V3{nan, nan, nan};  // all eroded: nothing to measure
     };
     const double c = std::abs(dot(mean(pe.a), mean(pe.b)));
+    if (std::isnan(c)) return c;
     return 90.0 - std::acos(std::min(1.0, c)) * 180.0 / M_PI;
   };
   // Cantilever bending (ASTM D1388) probes.
