@@ -9,23 +9,44 @@
 
 using namespace ncfsim;
 
+namespace {
+constexpr double kL = 0.01, kT = 0.5e-3, kRho = 1000, kEnd = 0.02;  // m, m, kg/m^3, s
+
+// An L x L x t elastic plate (8 x 8 x 1) in a frame pinned at (0, 0, 0) with arms of length L,
+// sheared to gamma_end (deg) at kEnd after a 2 ms ramp, quasi-static under mass damping. The
+// caller picks the frame's nodes (and walls) before the solver is built.
+fem::PictureFrame& plate_in_frame(fem::Model& model, double E, double nu, double gamma_end_deg) {
+  test::add_elastic_block(model, "plate", {0, 0, 0}, {kL, kL, kT}, {8, 8, 1}, kRho, E, nu);
+  fem::PictureFrame& pf = model.picture_frames.emplace_back();
+  pf.name = "frame";
+  pf.corner = {0, 0, 0};
+  pf.arm_length = kL;
+  pf.ramp_time = 0.002;
+  pf.shear_rate = gamma_end_deg * M_PI / 180 / (kEnd - 0.5 * pf.ramp_time);
+  model.mass_damping = 500;
+  model.time.end_time = kEnd;
+  return pf;
+}
+
+// Power the frame's pins put into the nodes at t^{n+1/2} (reactions times velocities).
+double pin_power(const fem::ExplicitSolver& solver) {
+  auto R = solver.reaction.view();
+  auto V = solver.v.view();
+  double p = 0;
+  for (auto node : solver.model().picture_frames[0].nodes)
+    for (int c = 0; c < 3; ++c) p += R[3 * node + c] * V[3 * node + c];
+  return p;
+}
+}  // namespace
+
 TEST(PictureFrame, ElasticPlateShearForce) {
   fem::Model model;
-  const double L = 0.01, t = 0.5e-3, E = 1e7, nu = 0.3, rho = 1000, G = E / (2 * (1 + nu));
-  test::add_elastic_block(model, "plate", {0, 0, 0}, {L, L, t}, {8, 8, 1}, rho, E, nu);
-  fem::PictureFrame pf;
-  pf.name = "frame";
+  const double L = kL, t = kT, E = 1e7, nu = 0.3, G = E / (2 * (1 + nu));
+  const double gamma_end = 5.0 * M_PI / 180, T = kEnd;
+  fem::PictureFrame& pf = plate_in_frame(model, E, nu, 5.0);
   pf.nodes = test::nodes_where(model.mesh, [&](double x, double y, double) {
     return x < 1e-9 || y < 1e-9 || x > L - 1e-9 || y > L - 1e-9;
   });
-  pf.corner = {0, 0, 0};
-  pf.arm_length = L;
-  const double gamma_end = 5.0 * M_PI / 180, T = 0.02;
-  pf.ramp_time = 0.002;
-  pf.shear_rate = gamma_end / (T - 0.5 * pf.ramp_time);
-  model.picture_frames.push_back(pf);
-  model.mass_damping = 500;  // quasi-static
-  model.time.end_time = T;
   fem::ExplicitSolver solver(model);
   double Fs = 0, gamma = 0;
   while (solver.time() < T) {
@@ -34,12 +55,7 @@ TEST(PictureFrame, ElasticPlateShearForce) {
       gamma = fem::picture_frame_angle(f, solver.time());
       const double gd = fem::picture_frame_rate(f, solver.time());
       const double theta = 0.25 * M_PI - 0.5 * gamma;
-      auto R = solver.reaction.view();
-      auto V = solver.v.view();
-      double power = 0;
-      for (auto node : f.nodes)
-        for (int c = 0; c < 3; ++c) power += R[3 * node + c] * V[3 * node + c];
-      Fs = power / (L * std::sin(theta) * gd) / (2 * std::cos(theta));
+      Fs = pin_power(solver) / (L * std::sin(theta) * gd) / (2 * std::cos(theta));
     });
   }
   EXPECT_NEAR(gamma, gamma_end, 1e-3 * gamma_end);
@@ -63,34 +79,19 @@ TEST(PictureFrame, ElasticPlateShearForce) {
 // beyond an arm than a small penalty penetration.
 TEST(PictureFrame, ArmsAsWallsSqueezeAPlateAndBalance) {
   fem::Model model;
-  const double L = 0.01, t = 0.5e-3, E = 1e6, nu = 0.0, rho = 1000;
-  test::add_elastic_block(model, "plate", {0, 0, 0}, {L, L, t}, {8, 8, 1}, rho, E, nu);
-  fem::PictureFrame pf;
-  pf.name = "frame";
+  const double L = kL, T = kEnd;
+  fem::PictureFrame& pf = plate_in_frame(model, 1e6, 0.0, 10.0);
   pf.nodes = test::nodes_where(model.mesh, [&](double x, double y, double) {
     return std::abs(x - 0.5 * L) < 1e-9 && std::abs(y - 0.5 * L) < 1e-9;
   });
   ASSERT_EQ(pf.nodes.size(), 2u);
   const auto all = test::nodes_where(model.mesh, [](double, double, double) { return true; });
   pf.walls = {all, all};
-  pf.corner = {0, 0, 0};
-  pf.arm_length = L;
-  const double gamma_end = 10.0 * M_PI / 180, T = 0.02;
-  pf.ramp_time = 0.002;
-  pf.shear_rate = gamma_end / (T - 0.5 * pf.ramp_time);
-  model.picture_frames.push_back(pf);
-  model.mass_damping = 500;
-  model.time.end_time = T;
   fem::ExplicitSolver solver(model);
   double w_frame = 0, p_prev = 0, dt_prev = 0;
   while (solver.time() < T) {
     solver.step([&] {
-      const auto& f = solver.model().picture_frames[0];
-      auto R = solver.reaction.view();
-      auto V = solver.v.view();
-      double p = solver.frame_wall_power(0);
-      for (auto node : f.nodes)
-        for (int c = 0; c < 3; ++c) p += R[3 * node + c] * V[3 * node + c];
+      const double p = solver.frame_wall_power(0) + pin_power(solver);
       w_frame += 0.5 * (p + p_prev) * dt_prev;  // power at t^{n+1/2}, trapezoid between them
       p_prev = p;
       dt_prev = solver.time_step();
