@@ -130,14 +130,22 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
 
   if (f.stitch == StitchPattern::None) return fm;
 
-  // Stitch nodes at the penetration points, on the top and bottom faces. Lattice index (i, j),
-  // i along the wale; index ranges cover the blanket whatever the stitch direction.
+  // Stitch nodes at the penetration points, one on every ply boundary (bottom face, interfaces,
+  // top face). Lattice index (i, j), i along the wale; index ranges cover the blanket whatever the
+  // stitch direction. The thread in a penetration hole bears on the tow edges of every ply it
+  // passes: its nodes at the interfaces join the tows on both sides, so the plies are pinned to
+  // each other at the stitch points (with a leg from the top to the bottom face only, held at its
+  // ends, a relative slide d of the plies there met only the leg's second-order stretch d^2/2l).
+  const std::size_t n_levels = f.ply_angles_deg.size() + 1;
   const double z_bot = bl.z0, z_top = bl.z0 + t * static_cast<double>(f.ply_angles_deg.size());
+  auto level_z = [&](std::size_t k) { return bl.z0 + t * static_cast<double>(k); };
   const int reach_i = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / s)) + 1;
   const int reach_j = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / g)) + 1;
   const int i0 = -reach_i, j0 = -reach_j, ni = 2 * reach_i + nx, nj = 2 * reach_j + ny;
   const double mx = 0.5 * (s * std::abs(mdir[0]) + g * std::abs(ndir[0])), my = 0.5 * (s * std::abs(mdir[1]) + g * std::abs(ndir[1]));
-  std::vector<std::int32_t> top(static_cast<std::size_t>(ni * nj), -1), bot(top);
+  // level[k][j * ni + i]: stitch node on ply boundary k (0: bottom face), -1 where none.
+  std::vector<std::vector<std::int32_t>> level(
+      n_levels, std::vector<std::int32_t>(static_cast<std::size_t>(ni * nj), -1));
   int i_min = 1 << 30;
   for (int jj = 0; jj < nj; ++jj)
     for (int ii = 0; ii < ni; ++ii) {
@@ -146,10 +154,11 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       if (x < lo[0] + mx - 1e-9 * Lx || x > hi[0] - mx + 1e-9 * Lx || y < lo[1] + my - 1e-9 * Ly || y > hi[1] - my + 1e-9 * Ly)
         continue;
       i_min = std::min(i_min, ii);
-      for (auto* arr : {&top, &bot}) {
-        (*arr)[static_cast<std::size_t>(jj * ni + ii)] = static_cast<std::int32_t>(mesh.n_nodes());
+      for (std::size_t k = 0; k < n_levels; ++k) {
+        level[k][static_cast<std::size_t>(jj * ni + ii)] =
+            static_cast<std::int32_t>(mesh.n_nodes());
         fm.stitch_nodes.push_back(static_cast<std::int32_t>(mesh.n_nodes()));
-        mesh.coords.insert(mesh.coords.end(), {x, y, arr == &top ? z_top : z_bot});
+        mesh.coords.insert(mesh.coords.end(), {x, y, level_z(k)});
       }
       ++fm.n_penetrations;
     }
@@ -158,6 +167,8 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   fm.stitch_leg_part = mesh.add_part(prefix + "stitch_legs");
   const bool tricot = f.stitch == StitchPattern::Tricot;
   fm.stitch_Lambda_part = tricot ? mesh.add_part(prefix + "stitch_Lambda") : fm.stitch_I_part;
+  const auto& top = level.back();
+  const auto& bot = level.front();
   auto at = [&](const std::vector<std::int32_t>& arr, int i, int j) -> std::int32_t {
     if (i < 0 || j < 0 || i >= ni || j >= nj) return -1;
     return arr[static_cast<std::size_t>(j * ni + i)];
@@ -178,22 +189,32 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
         bar(at(bot, i, j), at(bot, i + 1, j), fm.stitch_I_part);
       }
     }
-  for (int j = 0; j < nj; ++j)
-    for (int i = 0; i < ni; ++i) bar(at(top, i, j), at(bot, i, j), fm.stitch_leg_part);
+  for (std::size_t k = 0; k + 1 < n_levels; ++k)  // legs, one bar per ply
+    for (int j = 0; j < nj; ++j)
+      for (int i = 0; i < ni; ++i)
+        bar(at(level[k + 1], i, j), at(level[k], i, j), fm.stitch_leg_part);
 
-  // Connections: each stitch node to the nearest node of every tow within reach on its face.
+  // Connections: each stitch node to the nearest node of every tow within reach on its ply
+  // boundary (on an interface: the tows of both plies). The reach grows with the element length
+  // so that the nearest node of a tow beside the gap is found; on meshes with elements longer
+  // than the tow pitch (the case files' coarse resolution) it also takes the next tows over
+  // (docs/fabric-data.md).
   const double reach = 0.5 * f.tow_gap + std::max(w / nw, h_el) * 0.75;
   const double cell = reach;
-  std::map<std::array<long, 2>, std::vector<std::int32_t>> grid;  // face nodes of tows, bucketed
+  const double z_tol = 1e-9 * (1 + std::abs(z_top) + std::abs(z_bot));
+  std::map<std::array<long, 2>, std::vector<std::int32_t>>
+      grid;  // tow nodes on ply boundaries, bucketed
   std::vector<std::int32_t> tow_of_node(mesh.n_nodes(), -1);
   for (std::size_t e = 0; e < fm.tow_of_hex.size(); ++e) {
     const std::size_t he = mesh.hexes.size() - fm.tow_of_hex.size() + e;
     for (auto nd : mesh.hexes[he]) tow_of_node[static_cast<std::size_t>(nd)] = fm.tow_of_hex[e];
   }
+  auto on_a_level = [&](double z) {
+    const double k = std::round((z - bl.z0) / t);
+    return k >= 0 && k < static_cast<double>(n_levels) && std::abs(z - (bl.z0 + k * t)) <= z_tol;
+  };
   for (std::size_t nd = 0; nd < tow_of_node.size(); ++nd) {
-    if (tow_of_node[nd] < 0) continue;
-    const double z = mesh.coords[3 * nd + 2];
-    if (std::abs(z - z_top) > 1e-9 * (1 + z_top) && std::abs(z - z_bot) > 1e-9 * (1 + z_top)) continue;
+    if (tow_of_node[nd] < 0 || !on_a_level(mesh.coords[3 * nd + 2])) continue;
     grid[{static_cast<long>(std::floor(mesh.coords[3 * nd] / cell)), static_cast<long>(std::floor(mesh.coords[3 * nd + 1] / cell))}]
         .push_back(static_cast<std::int32_t>(nd));
   }
@@ -208,15 +229,14 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
         if (it == grid.end()) continue;
         for (auto nd : it->second) {
           const std::size_t k = static_cast<std::size_t>(nd);
-          if (std::abs(mesh.coords[3 * k + 2] - z) > 1e-9 * (1 + z_top)) continue;
+          if (std::abs(mesh.coords[3 * k + 2] - z) > z_tol) continue;
           const double d = std::hypot(mesh.coords[3 * k] - x, mesh.coords[3 * k + 1] - y);
           if (d > reach) continue;
           auto [it2, fresh] = best.try_emplace(tow_of_node[k], d, nd);
           if (!fresh && d < it2->second.first) it2->second = {d, nd};
         }
       }
-    for (const auto& [tow, dn] : best)
-      if (dn.second >= 0) fm.connections.push_back({sn, dn.second});
+    for (const auto& [tow, dn] : best) fm.connections.push_back({sn, dn.second});
   }
   return fm;
 }

@@ -1,9 +1,11 @@
 #pragma once
 // Builds a meso model of a rectangular NCF blanket: each ply as distinct rows of hexahedra, one row
-// per tow (the paper's Fig. 3), tows placed so that the stitch penetration points fall into the gaps
-// between tows; the stitch as bar elements ('I' pillar segments on the top face, 'Lambda' zig-zag
-// underlaps on the bottom face for tricot, legs through the thickness at the penetration points);
-// each stitch node joined to the nearest node of each neighbouring tow by a connection.
+// per tow (the paper's Fig. 3), tows placed so that the stitch penetration points fall into the
+// gaps between tows; the stitch as bar elements ('I' pillar segments on the top face, 'Lambda'
+// zig-zag underlaps on the bottom face for tricot, legs through the thickness at the penetration
+// points, one bar per ply, with a stitch node on every ply boundary); each stitch node joined by a
+// connection to the nearest node of each of the two tows beside its gap on that boundary (on an
+// interface: the tows of both plies, which pins the plies to each other at the stitch points).
 #include <array>
 #include <cstdint>
 #include <string>
