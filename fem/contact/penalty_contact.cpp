@@ -347,17 +347,17 @@ void PenaltyContact::sort_segments(const double* x) {
     used_cand_start_.push_back(seg_count_[n_seg]);
     const std::size_t n_cand = cand_seg_.size();
     ucand_node_.resize(n_cand);
+    ucand_mnode_.resize(n_cand);
     ucand_facet_.resize(n_cand);
     for (std::size_t e = 0; e < n_node; ++e)
       for (std::int32_t c = cand_start_[e]; c < cand_start_[e + 1]; ++c) {
         const auto q = static_cast<std::size_t>(cand_seg_[static_cast<std::size_t>(c)]);
         const auto r = static_cast<std::size_t>(seg_count_[q]++);
         ucand_node_[r] = static_cast<std::int32_t>(e);
+        ucand_mnode_[r] = surf_.node[e];
         ucand_facet_[r] = facet_start_[e] + cand_facet_[static_cast<std::size_t>(c)];
       }
-    best_seg_.resize(static_cast<std::size_t>(facet_start_[n_node]));
-    best_gap_.resize(best_seg_.size());
-    best_.resize(best_seg_.size());
+    best_.assign(static_cast<std::size_t>(facet_start_[n_node]), BestHit{});
   }
   ++stats_.n_sorts;
   stats_.n_candidates = static_cast<std::int64_t>(cand_seg_.size());
@@ -413,17 +413,13 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   double* offset = offset_.data();
   double* elastic = elastic_.data();
   std::int32_t* last = last_seg_.data();
-  std::int32_t* best_seg = best_seg_.data();
-  double* best_gap = best_gap_.data();
-  BestHit* best = best_.data();
-  const std::size_t n_facet_all = best_seg_.size();
-  std::fill_n(best_seg, n_facet_all, -1);
-  std::fill_n(best_gap, n_facet_all, -std::numeric_limits<double>::max());
+  BestHit* best = best_.data();  // all reset (seg -1) by the force pass of the last cycle
   {
     const std::size_t n_used = used_seg_.size();
     const std::int32_t* used = used_seg_.data();
     const std::int32_t* ustart = used_cand_start_.data();
     const std::int32_t* unode = ucand_node_.data();
+    const std::int32_t* umnode = ucand_mnode_.data();
     const std::int32_t* ufacet = ucand_facet_.data();
     SegmentFrameBlock fb;
     for (std::size_t u0 = 0; u0 < n_used; u0 += kFrameLanes) {
@@ -435,23 +431,26 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
         const double d = fb.depth[l];
         const auto li = static_cast<int>(l);
         for (std::int32_t c = ustart[u0 + l]; c < ustart[u0 + l + 1]; ++c) {
-          const auto e = static_cast<std::size_t>(unode[c]);
           const auto fi = static_cast<std::size_t>(ufacet[c]);
-          const double* xp = x + 3 * static_cast<std::size_t>(node[e]);
+          const double* xp = x + 3 * static_cast<std::size_t>(umnode[c]);
           const SegmentProjection pr = project_on_segment(fb, li, xp[0], xp[1], xp[2]);
+          BestHit& B = best[fi];
           bool hit = (std::abs(pr.xi) <= lim) & (std::abs(pr.eta) <= lim) & (pr.gap < thick) &
-                     (pr.gap > -d) & (pr.gap > best_gap[fi]);
+                     (pr.gap > -d) & (pr.gap > B.gap);
           // Closest feature (see closer_adjacent_face): a tow-end node lying on a thin tow's
           // top face also projects onto the tow's side face (at its top edge), up to half the
           // tow width 'deep', and its end facet faces that side: the top face is the contact,
           // the side is not.
-          if (hit && adj[0] >= 0)
+          if (hit && adj[0] >= 0) {
+            const auto e = static_cast<std::size_t>(unode[c]);
             hit = !closer_adjacent_face(x, adj, &facet_[3 * kMaxFacets * e], n_facets[e], xp[0],
                                         xp[1], xp[2], thick - pr.gap, last[fi] == s);
+          }
           if (hit) {
-            best_seg[fi] = s;
-            best_gap[fi] = pr.gap;
-            best[fi] = {pr.xi, pr.eta, {fb.n[0][l], fb.n[1][l], fb.n[2][l]}};
+            B.gap = pr.gap;
+            B.xi = static_cast<float>(pr.xi), B.eta = static_cast<float>(pr.eta);
+            for (int k = 0; k < 3; ++k) B.n[k] = static_cast<float>(fb.n[k][l]);
+            B.seg = s;
           }
         }
       }
@@ -492,14 +491,15 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     for (std::size_t fi = f0; fi < f0 + static_cast<std::size_t>(nf); ++fi) {
       double* ft = tang + 3 * fi;
       const std::int32_t was = last[fi];
-      last[fi] = best_seg[fi];
-      if (best_seg[fi] < 0) {
+      const BestHit F = best[fi];
+      best[fi] = BestHit{};  // ready for the next cycle's narrow phase
+      last[fi] = F.seg;
+      if (F.seg < 0) {
         if (was >= 0) ft[0] = ft[1] = ft[2] = 0, offset[fi] = 0, elastic[fi] = 0;  // else zero
         continue;
       }
       ++n_active;
-      const auto s = static_cast<std::size_t>(best_seg[fi]);
-      const BestHit& F = best[fi];
+      const auto s = static_cast<std::size_t>(F.seg);
       const std::int32_t* corner = sn + 4 * s;
       const int l = B.n++;
       double N[4];
@@ -516,10 +516,10 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
       // tows) starts from zero force, and at a switch to another segment the elastic part of
       // the penetration carries over. The offset only ever shrinks while the contact lasts (the
       // node withdrawing takes it with it), so the law can lose energy but never create it.
-      const double pen_geo = thick - best_gap[fi];
-      double off = was < 0 ? pen_geo
-                   : was != best_seg[fi] ? std::max(pen_geo - elastic[fi], 0.0)
-                                         : std::min(offset[fi], pen_geo);
+      const double pen_geo = thick - F.gap;
+      double off = was < 0        ? pen_geo
+                   : was != F.seg ? std::max(pen_geo - elastic[fi], 0.0)
+                                  : std::min(offset[fi], pen_geo);
       off = std::max(off, 0.0);
       offset[fi] = off;
       const double pen = pen_geo - off;
