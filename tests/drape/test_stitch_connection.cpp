@@ -4,6 +4,9 @@
 // balance closes (< 1 %).
 #include <gtest/gtest.h>
 
+#include <map>
+
+#include "drape/fabric_generator.hpp"
 #include "drape/stitch_connection.hpp"
 #include "fem/solver.hpp"
 #include "tests/test_support.hpp"
@@ -57,5 +60,70 @@ TEST(StitchConnection, ElasticThenSlidingAtTheSlidingForce) {
   const double slip = u - 0.5 / 2000;
   EXPECT_NEAR(conn->slip_length(0), slip, 0.01 * slip);
   EXPECT_NEAR(conn->friction_dissipation(), 0.5 * slip, 0.01 * 0.5 * slip);
+  EXPECT_LT(solver.energy().error(), 0.01);
+}
+
+// The stitch pins the two plies of a blanket to each other at its penetration points: a 20 x 20 mm
+// +-45 blanket whose bottom ply is held while the top ply is pulled 20 um along x (tows stiff,
+// no contact, so only the stitch couples the plies) is held back by the stitch nodes on the ply
+// interface. Each is joined to n1 tows of the bottom ply and n2 of the top one; once they slide
+// it holds min(n1, n2) F_s (the sum within 2 %). The legs, tension-only bars across a ply, add only
+// a second-order term (a tilt d over the ply thickness t stretches a leg by d^2 / 2t): with the leg
+// from the top face to the bottom face alone the plies would slide over each other almost freely.
+TEST(StitchConnection, StitchPinsThePliesToEachOther) {
+  fem::Model model;
+  drape::FabricSpec f;
+  drape::BlanketSpec bl;
+  bl.size = {0.02, 0.02};
+  const drape::FabricModel fm = drape::generate_blanket(model.mesh, f, bl);
+  model.parts.resize(model.mesh.part_names.size());
+  model.materials.push_back(std::make_unique<fem::ElasticIsotropic>("tow", 1080, 1e9, 0.3));
+  for (int p : fm.ply_parts)
+    model.parts[static_cast<std::size_t>(p)] = {fem::PartProperties::Kind::Solid, 0};
+  // A heavy yarn (100 x 76 dtex) lets the joints be stiff (their stiffness is capped by the stitch
+  // node mass): they slide after ~0.1 um, well before the 20 um of pull.
+  model.bar_laws.push_back(fem::BarForceLaw::linear("stitch", 2.0, true, 7.6e-4));
+  for (int p : {fm.stitch_I_part, fm.stitch_Lambda_part, fm.stitch_leg_part}) {
+    model.parts[static_cast<std::size_t>(p)].kind = fem::PartProperties::Kind::Bar;
+    model.parts[static_cast<std::size_t>(p)].bar_law = 0;
+  }
+  std::vector<int> ply_of_node(model.mesh.n_nodes(), -1);
+  for (std::size_t e = 0; e < model.mesh.hexes.size(); ++e)
+    for (auto nd : model.mesh.hexes[e])
+      ply_of_node[static_cast<std::size_t>(nd)] =
+          fm.ply_of_tow[static_cast<std::size_t>(fm.tow_of_hex[e])];
+  fem::FixedDofs hold;
+  hold.name = "bottom_ply";
+  fem::PrescribedVelocity pull;
+  pull.name = "top_ply";
+  pull.dofs = {true, true, true};
+  pull.velocity = {0.01, 0, 0};  // m/s: 20 um in 2 ms (+ half the ramp)
+  pull.ramp_time = 5e-4;
+  for (std::size_t i = 0; i < ply_of_node.size(); ++i) {
+    if (ply_of_node[i] == 0) hold.nodes.push_back(static_cast<std::int32_t>(i));
+    if (ply_of_node[i] == 1) pull.nodes.push_back(static_cast<std::int32_t>(i));
+  }
+  model.fixed.push_back(hold);
+  model.velocities.push_back(pull);
+  drape::StitchConnectionSettings s;
+  s.sliding_force = 0.05;
+  model.contacts.push_back(
+      std::make_unique<drape::StitchToTowConnection>("stitch_tow", fm.connections, s));
+  model.time.end_time = 2.25e-3;
+  // What the interface nodes can hold once their joints slide.
+  const double t = fm.tow_thickness;
+  std::map<std::int32_t, std::array<int, 2>> per_ply;
+  for (const auto& c : fm.connections)
+    if (std::abs(model.mesh.coords[3 * static_cast<std::size_t>(c.stitch_node) + 2] - t) < 1e-9 * t)
+      ++per_ply[c.stitch_node]
+               [static_cast<std::size_t>(ply_of_node[static_cast<std::size_t>(c.tow_node)])];
+  double holding = 0;
+  for (const auto& [nd, n] : per_ply) holding += std::min(n[0], n[1]) * s.sliding_force;
+  ASSERT_GT(holding, 10 * s.sliding_force);
+
+  fem::ExplicitSolver solver(model);
+  while (solver.time() < model.time.end_time) solver.step();
+  const fem::V3 F = solver.reaction_force(pull.nodes);
+  EXPECT_NEAR(F.x, holding, 0.02 * holding) << "the top ply is held by the interface joints";
   EXPECT_LT(solver.energy().error(), 0.01);
 }
