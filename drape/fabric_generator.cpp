@@ -202,8 +202,8 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   const double reach = 0.5 * f.tow_gap + std::max(w / nw, h_el) * 0.75;
   const double cell = reach;
   const double z_tol = 1e-9 * (1 + std::abs(z_top) + std::abs(z_bot));
-  std::map<std::array<long, 2>, std::vector<std::int32_t>>
-      grid;  // tow nodes on ply boundaries, bucketed
+  // Tow nodes on ply boundaries, bucketed.
+  std::map<std::array<long, 2>, std::vector<std::int32_t>> grid;
   std::vector<std::int32_t> tow_of_node(mesh.n_nodes(), -1);
   for (std::size_t e = 0; e < fm.tow_of_hex.size(); ++e) {
     const std::size_t he = mesh.hexes.size() - fm.tow_of_hex.size() + e;

@@ -4,8 +4,9 @@
 // gaps between tows; the stitch as bar elements ('I' pillar segments on the top face, 'Lambda'
 // zig-zag underlaps on the bottom face for tricot, legs through the thickness at the penetration
 // points, one bar per ply, with a stitch node on every ply boundary); each stitch node joined by a
-// connection to the nearest node of each of the two tows beside its gap on that boundary (on an
-// interface: the tows of both plies, which pins the plies to each other at the stitch points).
+// connection to the nearest node of each tow beside its gap on that boundary (on an interface:
+// the tows of both plies, which pins the plies to each other at the stitch points; on meshes with
+// elements longer than the tow pitch the search also reaches the next tows over).
 #include <array>
 #include <cstdint>
 #include <string>

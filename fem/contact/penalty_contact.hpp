@@ -137,8 +137,8 @@ class PenaltyContact final : public ContactAlgorithm {
   // its surface node (only for the closest-feature test).
   std::vector<std::int32_t> used_seg_, used_cand_start_, ucand_node_, ucand_mnode_, ucand_facet_;
   std::vector<std::int32_t> seg_count_;  // [n_seg + 1] work array of the counting sort
-  /// Best hit of a node facet in the current cycle: one record of 32 bytes per facet, written by
-  /// the narrow phase and read (then reset) by the force pass, so a facet costs one cache line.
+  /// Best hit of a node facet in the current cycle: one record of 32 bytes per facet (was three
+  /// arrays), written by the narrow phase and read, then reset, by the force pass.
   /// Local coordinates and normal in single precision: they only place and orient the force,
   /// the same values on the node and on the segment (momentum stays exact).
   struct BestHit {
