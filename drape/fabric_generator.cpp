@@ -211,7 +211,8 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   }
   auto on_a_level = [&](double z) {
     const double k = std::round((z - bl.z0) / t);
-    return k >= 0 && k < static_cast<double>(n_levels) && std::abs(z - (bl.z0 + k * t)) <= z_tol;
+    return k >= 0 && k < static_cast<double>(n_levels) &&
+           std::abs(z - level_z(static_cast<std::size_t>(k))) <= z_tol;
   };
   for (std::size_t nd = 0; nd < tow_of_node.size(); ++nd) {
     if (tow_of_node[nd] < 0 || !on_a_level(mesh.coords[3 * nd + 2])) continue;
