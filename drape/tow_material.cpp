@@ -21,8 +21,11 @@ TowMaterial::TowMaterial(std::string name, const TowConstants& c) : name_(std::m
   require(c.locking_width_ratio > 0 && c.locking_width_ratio < 1, "locking_width_ratio must be in (0, 1)");
   require(c.lock_stiffness_ratio >= 1, "lock_stiffness_ratio must be >= 1");
   fem::OrthotropicConstants m{c.E11m, c.E22m, c.E33m, c.nu12m, c.nu13m, c.nu23m, c.G12m, c.G13m, c.G23m};
+  require(c.E11f_axial >= 0, "E11f_axial must be >= 0");
   C_ = fem::orthotropic_stiffness(m);  // throws if the matrix phase is not positive definite
-  C_[0] += c.E11f;
+  C_bend_ = C_;
+  C_bend_[0] += c.E11f;
+  C_[0] += c.E11f_axial > 0 ? c.E11f_axial : c.E11f;
   const double l = c.locking_width_ratio;
   e_lock_ = 0.5 * (1 - l * l);
   // Tangent E_c/(1-r)^2 reaches the cap at r_cap.

@@ -5,7 +5,9 @@
 //
 //   S = C_f E + C_m E + s_c(Ê2) m_2 (x) m_2 + s_c(Ê3) m_3 (x) m_3   (compaction_measure =
 //   "fibre_sheet_spacing"; the default "transverse_strain" uses Ê2 = E22, m_2 = e_2, Ê3 = E33, m_3 = e_3)
-//   C_f = E11f e_1 (x) e_1 (fibres carry only axial stress);
+//   C_f = E11f e_1 (x) e_1 (fibres carry only axial stress); optionally the uniform axial strain
+//   (tow stretch) takes E11f_axial instead, E11f then setting only bending (bending_stiffness,
+//   the physical hourglass stabilisation of the one-point hexahedra: docs/theory.md);
 //   C_m = orthotropic matrix phase (E11m, E22m, E33m, nu12m, nu13m, nu23m, G12m, G13m, G23m);
 //   Ê2 = (lambda_2^2 - 1)/2 with lambda_2 = 1/sqrt((C^-1)_22) the stretch of the SPACING of the
 //   material planes X2 = const (fibre sheets stacked across the tow width), m_2 = C^-1 e_2 /
@@ -29,6 +31,9 @@ namespace ncfsim::drape {
 struct TowConstants {
   double density = 0;           // kg/m^3 of the dry tow (fibre density x fibre volume fraction)
   double E11f = 0;              // Pa, fibre phase, axial (bending-calibrated, paper: 0.07 GPa)
+  // Pa, fibre phase of the uniform axial strain (tow stretch) when it differs from the bending
+  // one; 0: E11f in both (the paper's Eq. 1). E11f then sets only the bending stiffness.
+  double E11f_axial = 0;
   double E11m = 0, E22m = 0, E33m = 0;   // Pa, matrix phase
   double nu12m = 0, nu13m = 0, nu23m = 0;
   double G12m = 0, G13m = 0, G23m = 0;   // Pa
@@ -54,6 +59,7 @@ class TowMaterial final : public fem::SolidMaterial {
   double density() const override { return c_.density; }
   double p_wave_modulus() const override;
   fem::Voigt6x6 elastic_stiffness() const override { return C_; }
+  fem::Voigt6x6 bending_stiffness() const override { return C_bend_; }
   fem::Voigt6x6 stable_step_stiffness() const override;
   int n_history() const override { return 6; }
   void update_stress(const fem::MaterialBatch& batch) const override;
@@ -73,7 +79,8 @@ class TowMaterial final : public fem::SolidMaterial {
  private:
   std::string name_;
   TowConstants c_;
-  fem::Voigt6x6 C_{};  // C_f + C_m
+  fem::Voigt6x6 C_{};       // C_f + C_m, with the axial fibre modulus
+  fem::Voigt6x6 C_bend_{};  // C_f + C_m, with the bending fibre modulus E11f
   double e_lock_ = 0, r_cap_ = 0;
 };
 

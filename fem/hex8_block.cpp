@@ -121,6 +121,57 @@ double uniform_strain_modulus(const Voigt6x6& C) {
   return std::max(normal, shear);
 }
 
+// Largest eigenvalue of C G, G the 6x6 Gram matrix of the rows of the uniform-strain operator
+// (Voigt 11 22 33 12 23 13, engineering shear) of nodal gradients whose Gram matrix is D = sum_I
+// b_I b_I^T (row-major 3x3, in the axes of C), e.g. <eps11, gamma12> = D12: the stiffness of the
+// strain modes per unit mass is 8/rho times it. Computed as that of G^1/2 C G^1/2.
+double strain_operator_eigenvalue(const Voigt6x6& Cv, const double D[9]) {
+  const double D11 = D[0], D22 = D[4], D33 = D[8], D12 = D[1], D23 = D[5], D13 = D[2];
+  Eigen::Matrix<double, 6, 6> G = Eigen::Matrix<double, 6, 6>::Zero(), C;
+  auto set = [&](int a, int b, double v) { G(a, b) = G(b, a) = v; };
+  set(0, 0, D11), set(1, 1, D22), set(2, 2, D33);
+  set(3, 3, D11 + D22), set(4, 4, D22 + D33), set(5, 5, D11 + D33);
+  set(0, 3, D12), set(0, 5, D13), set(1, 3, D12), set(1, 4, D23), set(2, 4, D23), set(2, 5, D13);
+  set(3, 4, D13), set(3, 5, D23), set(4, 5, D12);
+  for (int a = 0; a < 6; ++a)
+    for (int b = 0; b < 6; ++b) C(a, b) = 0.5 * (Cv[6 * a + b] + Cv[6 * b + a]);
+  const Eigen::Matrix<double, 6, 6> Gh =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(G).operatorSqrt();
+  const Eigen::Matrix<double, 6, 6> A = Gh * C * Gh;
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(A, Eigen::EigenvaluesOnly)
+      .eigenvalues()
+      .maxCoeff();
+}
+
+// Largest eigenvalue of the right Cauchy-Green tensor, bounded by its largest Gershgorin row.
+inline double cauchy_green_bound(double C11, double C22, double C33, double C12, double C23,
+                                 double C13) {
+  const double a = std::abs(C12), b = std::abs(C23), c = std::abs(C13);
+  return std::max({C11 + a + c, C22 + a + b, C33 + b + c});
+}
+
+// Isotropic stiffness (within round-off): the directional bound is not used for it. On a cube it
+// equals the Flanagan-Belytschko bound anyway, and the margin that bound leaves on thin isotropic
+// elements is what penalty contacts up to penalty_scale 0.5 rely on (fem/contact/README.md).
+bool is_isotropic(const Voigt6x6& C) {
+  const double c11 = C[0], c12 = C[1], tol = 1e-9 * std::abs(c11);
+  auto eq = [&](double a, double b) { return std::abs(a - b) <= tol; };
+  bool iso = eq(C[7], c11) && eq(C[14], c11) && eq(C[2], c12) && eq(C[8], c12);
+  for (int k = 3; k < 6; ++k) iso = iso && eq(C[6 * k + k], 0.5 * (c11 - c12));
+  for (int a = 0; a < 6; ++a)
+    for (int b = 0; b < 6; ++b) {
+      if (a == b || (a < 3 && b < 3)) continue;
+      iso = iso && eq(C[6 * a + b], 0.0);
+    }
+  return iso;
+}
+
+// Step of the directional bound in the current shape (see Hex8Block::step_modulus).
+inline double directional_step(double rho, double cg_bound, double step_modulus, double lc0,
+                               double lc) {
+  return std::min(lc0, lc) * std::sqrt(rho / (std::max(cg_bound, 1.0) * step_modulus));
+}
+
 }  // namespace
 
 void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& M) {
@@ -137,7 +188,11 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
   b.volume0.assign(n, 0.0);
   b.density.assign(n, b.material->density());
   b.p_modulus = uniform_strain_modulus(b.material->stable_step_stiffness());
-  const Voigt6x6 C = b.material->elastic_stiffness();
+  b.step_modulus.assign(n, 0.0);
+  b.step_length0.assign(n, 0.0);
+  const Voigt6x6 C_step = b.material->stable_step_stiffness();
+  const bool directional = !is_isotropic(C_step);
+  const Voigt6x6 C = b.material->bending_stiffness();
   std::array<double, 9> last_T{};
   std::array<double, 6> last_moduli{};
   bool have_last = false;
@@ -161,6 +216,25 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
       for (int c = 0; c < 3; ++c)
         b.jac_inv0_axes[(3 * r + c) * n + e] = Ji[3 * r] * M[c] + Ji[3 * r + 1] * M[3 + c] + Ji[3 * r + 2] * M[6 + c];
     b.volume0[e] = g.V;
+    if (directional) {
+      // Gram matrix of the reference nodal gradients, D = 8/V^2 sum_k d_k d_k^T, in the material
+      // axes (M^T D M), for the directional step bound.
+      double Dg[9] = {};
+      for (int k = 1; k < 7; ++k) {
+        const double dk[3] = {g.d[k].x, g.d[k].y, g.d[k].z};
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) Dg[3 * r + c] += 8.0 / (g.V * g.V) * dk[r] * dk[c];
+      }
+      double Dm[9] = {};
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              Dm[3 * r + c] += M[3 * i + r] * Dg[3 * i + j] * M[3 * j + c];
+      const double lc0 = g.V / std::sqrt(max_face_area_sq(xe));
+      b.step_length0[e] = lc0;
+      b.step_modulus[e] = 2.0 * strain_operator_eigenvalue(C_step, Dm) * lc0 * lc0;
+    }
     std::array<double, 9> T{};  // element axes in the material frame: T = M^T R
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
@@ -206,6 +280,26 @@ void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>
     hex_geometry(xe, g);
     const double lc = g.V / std::sqrt(max_face_area_sq(xe));
     dt[e] = lc / std::sqrt(b.p_modulus / b.density[e]);
+    if (b.step_modulus[e] > 0) {
+      // F M = J jac_inv0_axes with J = [a1 a2 a3]; Cg = (F M)^T (F M) in the material axes.
+      double FM[9];
+      const Vec3 col[3] = {g.a[1], g.a[2], g.a[3]};
+      for (int c = 0; c < 3; ++c) {
+        const double j0 = b.jac_inv0_axes[(0 + c) * b.n + e],
+                     j1 = b.jac_inv0_axes[(3 + c) * b.n + e],
+                     j2 = b.jac_inv0_axes[(6 + c) * b.n + e];
+        FM[c] = col[0].x * j0 + col[1].x * j1 + col[2].x * j2;
+        FM[3 + c] = col[0].y * j0 + col[1].y * j1 + col[2].y * j2;
+        FM[6 + c] = col[0].z * j0 + col[1].z * j1 + col[2].z * j2;
+      }
+      auto cg = [&](int p, int q) {
+        return FM[p] * FM[q] + FM[3 + p] * FM[3 + q] + FM[6 + p] * FM[6 + q];
+      };
+      const double s =
+          cauchy_green_bound(cg(0, 0), cg(1, 1), cg(2, 2), cg(0, 1), cg(1, 2), cg(0, 2));
+      dt[e] = std::max(dt[e],
+                       directional_step(b.density[e], s, b.step_modulus[e], b.step_length0[e], lc));
+    }
     if (!corner_jacobian) continue;
     double j = 1e300;
     for (int c = 0; c < 8; ++c) {
@@ -226,6 +320,8 @@ void hex8_element_force(const Hex8Block& b, std::size_t e, const double* x, cons
   one.hourglass_stiffness = b.hourglass_stiffness;
   one.hourglass_viscosity = b.hourglass_viscosity;
   one.p_modulus = b.p_modulus;
+  one.step_modulus = {b.step_modulus[e]};
+  one.step_length0 = {b.step_length0[e]};
   auto take = [&](const std::vector<double>& from, std::vector<double>& to) {
     const std::size_t rows = b.n ? from.size() / b.n : 0;
     to.resize(rows);
@@ -358,6 +454,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
   const std::int32_t* conn = b.conn.data();
   const double* jm = b.jac_inv0_axes.data();
   const double* hgm = b.hg_moduli.data();
+  const double* smod = b.step_modulus.data();
+  const double* slen = b.step_length0.data();
   const double* rho = b.density.data();
   const double* vol0 = b.volume0.data();
   double* strain = b.strain.data();
@@ -380,6 +478,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
     rows(conn, 8, read);
     rows(jm, 9, read);
     rows(hgm, 6, read);
+    rows(smod, 1, read);
+    rows(slen, 1, read);
     rows(rho, 1, read);
     rows(vol0, 1, read);
     rows(strain, 6, write);
@@ -512,8 +612,21 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       store_a(&ilen[0][j], in1), store_a(&ilen[1][j], in2), store_a(&ilen[2][j], 1.0 / stdx::abs(dot(a[3], e3)));
       store_a(&Vol[j], V);
       store_a(&iVol[j], iV);
-      // Characteristic length V / A_max over the wave speed sqrt(p_modulus / rho).
-      store_a(&dtc[j], V * stdx::sqrt(load(rho + e, cnt) / (p_mod * amax_sq)));
+      // Characteristic length V / A_max over the wave speed sqrt(p_modulus / rho), or the
+      // directional bound where that allows more (hex8_element_steps).
+      const VD rho_e = load(rho + e, cnt);
+      const VD lc = V / stdx::sqrt(amax_sq);
+      VD step = lc * stdx::sqrt(rho_e / p_mod);
+      {
+        const VD sm = load(smod + e, cnt), lc0 = load(slen + e, cnt);
+        const VD a = stdx::abs(C12), bb = stdx::abs(C23), c = stdx::abs(C13);
+        const VD cg =
+            stdx::max(stdx::max(stdx::max(C11 + a + c, C22 + a + bb), C33 + bb + c), VD(1.0));
+        VD dir = stdx::min(lc0, lc) * stdx::sqrt(rho_e / (cg * sm));
+        stdx::where(!(sm > 0.0), dir) = 0.0;  // no bound (padding lanes)
+        step = stdx::max(step, dir);
+      }
+      store_a(&dtc[j], step);
     }
 
     // Pass B: constitutive update for the whole batch (one call, no per-element dispatch).

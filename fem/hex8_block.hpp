@@ -42,6 +42,17 @@ struct Hex8Block {
   double hourglass_stiffness = 1.0;    // scale of the physical stabilisation (1 = exact bending)
   double hourglass_viscosity = 0.05;   // fraction of critical damping on the hourglass modes
   double p_modulus = 0.0;              // modulus of the stable-step bound (uniform-strain hex)
+  // Directional step bound: lambda = largest eigenvalue of C G(D0), with D0 = sum_I B0_I B0_I^T
+  // of the reference nodal gradients in the material axes, G the 6x6 Gram matrix of the strain
+  // operator they make and C the material's stable-step stiffness: the uniform-strain modes of
+  // the reference shape have omega^2 <= 8/rho lambda (exact for a parallelepiped). Kept as the
+  // modulus 2 lambda lc0^2 at the reference characteristic length lc0 = V0/sqrt(A_max0); in the
+  // current shape dt = min(lc0, lc) sqrt(rho / (max(1, lambda_max(Cg)) step_modulus)), Cg the
+  // right Cauchy-Green tensor in the material axes: never above the reference bound, and it
+  // falls with the characteristic length as the element is crushed, as V/A_max does. 0 (not
+  // used) for an isotropic material.
+  std::vector<double> step_modulus;  // [n] Pa
+  std::vector<double> step_length0;  // [n] m
 };
 
 struct ElementEnergyIncrement {
@@ -64,11 +75,16 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
 /// Element nodal masses (rho V / 8) added into `mass` [3*n_nodes].
 void hex8_lumped_mass(const Hex8Block& b, double* mass);
 
-/// Stable time step of every element (characteristic length V/A_max over wave speed); an eroded
-/// element has none (1e300). With `corner_jacobian`, also the smallest corner Jacobian of each
-/// element (the triple product of the three edges leaving a corner, over the reference volume; 1
-/// for an undistorted box, <= 0 where the element folds over at that corner, which the one-point
-/// volume does not see; 1 for an eroded element).
+/// Stable time step of every element: the larger of two bounds on the uniform-strain frequency,
+/// the characteristic length V/A_max over the wave speed of the largest modulus (Flanagan-
+/// Belytschko), and, for an anisotropic material, the directional bound (step_modulus), exact for
+/// a parallelepiped at rest, which pairs
+/// each modulus with the element's length along its axis (a tow: fibre modulus with the tow
+/// length, compaction with the thickness). An eroded element has none (1e300). With
+/// `corner_jacobian`, also the smallest corner Jacobian of each element (the triple product of
+/// the three edges leaving a corner, over the reference volume; 1 for an undistorted box, <= 0
+/// where the element folds over at that corner, which the one-point volume does not see; 1 for
+/// an eroded element).
 StableStep hex8_stable_step(const Hex8Block& b, const double* x);
 void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt,
                         std::vector<double>* corner_jacobian = nullptr);

@@ -30,8 +30,12 @@ class SolidMaterial {
   virtual double density() const = 0;
   /// Largest dilatational modulus (rho c^2) the law can reach: sets the stable time step.
   virtual double p_wave_modulus() const = 0;
-  /// Initial elastic stiffness in the material frame (used for the hourglass stabilisation).
+  /// Initial elastic stiffness in the material frame.
   virtual Voigt6x6 elastic_stiffness() const = 0;
+  /// Stiffness of the linearly varying strain fields, i.e. of bending (the physical hourglass
+  /// stabilisation of one-point elements): the elastic one unless the law separates them (a
+  /// dry tow bends as a bundle of fibres sliding on each other, far below its axial stiffness).
+  virtual Voigt6x6 bending_stiffness() const { return elastic_stiffness(); }
   /// The stiffest tangent the law can reach (e.g. a compacted tow): bounds the stable step.
   virtual Voigt6x6 stable_step_stiffness() const { return elastic_stiffness(); }
   virtual int n_history() const { return 0; }

@@ -167,3 +167,77 @@ TEST(TowMaterial, SingleHexCompactionMatchesTheLaw) {
   EXPECT_NEAR(-reaction, -expected, 0.005 * std::abs(expected)) << "E22 = " << E;
   EXPECT_LT(E, -0.5 * mat->locking_strain());
 }
+
+namespace {
+// A tow strip 20 x 2 x 0.5 mm (one hexahedron through the thickness, 20 along), fibres along x,
+// clamped at x = 0, a tip force (x: pull, z: bend), settled by mass damping; tip displacement.
+double tow_strip_tip(const drape::TowConstants& c, int axis, double force) {
+  fem::Model model;
+  const double L = 20e-3, w = 2e-3, h = 0.5e-3;
+  const int p = model.mesh.add_part("tow");
+  fem::add_hex_block(model.mesh, p, {0, 0, 0}, {L, w, h}, {20, 2, 1});
+  model.materials.push_back(std::make_unique<drape::TowMaterial>("tow", c));
+  model.parts.resize(1);
+  model.parts[0].material = 0;
+  fem::FixedDofs root;
+  root.name = "root";
+  root.nodes = test::nodes_at(model.mesh, 0, 0.0);
+  model.fixed.push_back(root);
+  // Consistent nodal forces: the tip nodes on the mid-width line carry twice those on the edges.
+  const auto tip_nodes = test::nodes_at(model.mesh, 0, L);
+  for (int line = 0; line < 2; ++line) {
+    fem::NodalLoad tip;
+    for (auto i : tip_nodes) {
+      const bool mid =
+          std::abs(model.mesh.coords[3 * static_cast<std::size_t>(i) + 1] - 0.5 * w) < 1e-9;
+      if (mid == (line == 1)) tip.nodes.push_back(i);
+    }
+    fem::V3 F{};
+    (axis == 0 ? F.x : F.z) = force * (line == 1 ? 0.25 : 0.125);  // 2 mid + 4 edge nodes
+    tip.force_per_node = F;
+    tip.ramp_time = 0.02;
+    model.loads.push_back(tip);
+  }
+  const double E_bend = c.E11f + c.E11m, I = w * h * h * h / 12, rhoA = c.density * w * h;
+  const double omega1 = 1.875 * 1.875 * std::sqrt(E_bend * I / (rhoA * L * L * L * L));
+  model.mass_damping = 2.0 * omega1;
+  model.time.end_time = 0.25;
+  fem::ExplicitSolver solver(model);
+  while (solver.time() < model.time.end_time) solver.step();
+  double d = 0;
+  for (auto i : tip_nodes)
+    d += (test::node_coord(solver, i, axis == 0 ? 0 : 2) -
+          model.mesh.coords[3 * i + (axis == 0 ? 0 : 2)]) /
+         static_cast<double>(tip_nodes.size());
+  return d;
+}
+}  // namespace
+
+TEST(TowMaterial, AxialAndBendingFibreModuliSeparate) {
+  // E11f_axial sets the uniform axial strain (tow stretch), E11f the bending (the physical
+  // hourglass stabilisation of the one hexahedron through the thickness): a strip stretches by
+  // P L / (E_axial A) and bends by P L^3 / (3 E_bend I) (plus its shear deflection), each within 5
+  // %.
+  auto c = paper_tow();
+  c.compaction_modulus = 0;
+  c.E11f_axial = 0.7e9;  // ten times the bending value
+  const drape::TowMaterial m("tow", c);
+  EXPECT_DOUBLE_EQ(m.elastic_stiffness()[0], c.E11f_axial + c.E11m);
+  EXPECT_DOUBLE_EQ(m.bending_stiffness()[0], c.E11f + c.E11m);
+  EXPECT_GE(m.stable_step_stiffness()[0], c.E11f_axial);
+  const double L = 20e-3, w = 2e-3, h = 0.5e-3;
+  const double P_pull = 1.0, P_bend = 1e-4;
+  const double stretch = tow_strip_tip(c, 0, P_pull);
+  EXPECT_TRUE(test::near_rel(stretch, P_pull * L / ((c.E11f_axial + c.E11m) * w * h), 0.05))
+      << stretch;
+  const double deflection = tow_strip_tip(c, 2, P_bend);
+  const double I = w * h * h * h / 12;
+  // Timoshenko: the soft transverse shear of the tow (G13m) adds P L / (5/6 G A), 7 % here.
+  const double bending = P_bend * L * L * L / (3 * (c.E11f + c.E11m) * I);
+  const double shear = P_bend * L / (5.0 / 6.0 * c.G13m * w * h);
+  EXPECT_TRUE(test::near_rel(deflection, bending + shear, 0.05)) << deflection;
+  // Without E11f_axial the strip stretches ten times more (the paper's Eq. 1: one fibre modulus).
+  c.E11f_axial = 0;
+  EXPECT_TRUE(
+      test::near_rel(tow_strip_tip(c, 0, P_pull), P_pull * L / ((c.E11f + c.E11m) * w * h), 0.05));
+}

@@ -142,6 +142,7 @@ std::unique_ptr<fem::SolidMaterial> read_material(const TableReader& t, const st
       drape::TowConstants c;
       c.density = rho;
       c.E11f = t.number("E11f", Range::non_negative());
+      c.E11f_axial = t.number("E11f_axial", 0.0, Range::non_negative());
       c.E11m = t.number("E11m", Range::positive());
       c.E22m = t.number("E22m", Range::positive());
       c.E33m = t.number("E33m", Range::positive());

@@ -321,9 +321,10 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
       bs.overhang = hi[0] - lo[0], bs.width = hi[1] - lo[1], bs.thickness = hi[2] - lo[2];
       bs.areal_mass = solver.part_masses()[static_cast<std::size_t>(bp.part)].mass / (bs.overhang * bs.width);
       const auto& pp = model.parts[static_cast<std::size_t>(bp.part)];
-      const auto moduli = fem::directional_moduli(model.materials[static_cast<std::size_t>(pp.material)]->elastic_stiffness(),
-                                                  {1, 0, 0, 0, 1, 0, 0, 0, 1});
-      bs.E1 = moduli[0];  // along material axis 1
+      const auto moduli = fem::directional_moduli(
+          model.materials[static_cast<std::size_t>(pp.material)]->bending_stiffness(),
+          {1, 0, 0, 0, 1, 0, 0, 0, 1});
+      bs.E1 = moduli[0];  // bending modulus along material axis 1 (beam theory)
       bending_state.push_back(bs);
       hc.add(bp.name + "_tip_angle_deg");
     }
