@@ -188,10 +188,10 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
   b.volume0.assign(n, 0.0);
   b.density.assign(n, b.material->density());
   b.p_modulus = uniform_strain_modulus(b.material->stable_step_stiffness());
-  b.step_modulus.assign(n, 0.0);
-  b.step_length0.assign(n, 0.0);
   const Voigt6x6 C_step = b.material->stable_step_stiffness();
   const bool directional = !is_isotropic(C_step);
+  b.step_modulus.assign(directional ? n : 0, 0.0);
+  b.step_length0.assign(directional ? n : 0, 0.0);
   const Voigt6x6 C = b.material->bending_stiffness();
   std::array<double, 9> last_T{};
   std::array<double, 6> last_moduli{};
@@ -280,7 +280,7 @@ void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>
     hex_geometry(xe, g);
     const double lc = g.V / std::sqrt(max_face_area_sq(xe));
     dt[e] = lc / std::sqrt(b.p_modulus / b.density[e]);
-    if (b.step_modulus[e] > 0) {
+    if (!b.step_modulus.empty() && b.step_modulus[e] > 0) {
       // F M = J jac_inv0_axes with J = [a1 a2 a3]; Cg = (F M)^T (F M) in the material axes.
       double FM[9];
       const Vec3 col[3] = {g.a[1], g.a[2], g.a[3]};
@@ -320,8 +320,10 @@ void hex8_element_force(const Hex8Block& b, std::size_t e, const double* x, cons
   one.hourglass_stiffness = b.hourglass_stiffness;
   one.hourglass_viscosity = b.hourglass_viscosity;
   one.p_modulus = b.p_modulus;
-  one.step_modulus = {b.step_modulus[e]};
-  one.step_length0 = {b.step_length0[e]};
+  if (!b.step_modulus.empty()) {
+    one.step_modulus = {b.step_modulus[e]};
+    one.step_length0 = {b.step_length0[e]};
+  }
   auto take = [&](const std::vector<double>& from, std::vector<double>& to) {
     const std::size_t rows = b.n ? from.size() / b.n : 0;
     to.resize(rows);
@@ -454,6 +456,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
   const std::int32_t* conn = b.conn.data();
   const double* jm = b.jac_inv0_axes.data();
   const double* hgm = b.hg_moduli.data();
+  const bool directional = !b.step_modulus.empty();
   const double* smod = b.step_modulus.data();
   const double* slen = b.step_length0.data();
   const double* rho = b.density.data();
@@ -478,8 +481,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
     rows(conn, 8, read);
     rows(jm, 9, read);
     rows(hgm, 6, read);
-    rows(smod, 1, read);
-    rows(slen, 1, read);
+    if (directional) rows(smod, 1, read), rows(slen, 1, read);
     rows(rho, 1, read);
     rows(vol0, 1, read);
     rows(strain, 6, write);
@@ -617,7 +619,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       const VD rho_e = load(rho + e, cnt);
       const VD lc = V / stdx::sqrt(amax_sq);
       VD step = lc * stdx::sqrt(rho_e / p_mod);
-      {
+      if (directional) {
         const VD sm = load(smod + e, cnt), lc0 = load(slen + e, cnt);
         const VD a = stdx::abs(C12), bb = stdx::abs(C23), c = stdx::abs(C13);
         const VD cg =

@@ -49,7 +49,7 @@ struct Hex8Block {
   // modulus 2 lambda lc0^2 at the reference characteristic length lc0 = V0/sqrt(A_max0); in the
   // current shape dt = min(lc0, lc) sqrt(rho / (max(1, lambda_max(Cg)) step_modulus)), Cg the
   // right Cauchy-Green tensor in the material axes: never above the reference bound, and it
-  // falls with the characteristic length as the element is crushed, as V/A_max does. 0 (not
+  // falls with the characteristic length as the element is crushed, as V/A_max does. Empty (not
   // used) for an isotropic material.
   std::vector<double> step_modulus;  // [n] Pa
   std::vector<double> step_length0;  // [n] m
