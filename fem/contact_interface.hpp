@@ -20,6 +20,7 @@ struct ContactSetup {
   const double* x0 = nullptr;    // reference positions [3*n_nodes]
   const double* mass = nullptr;  // lumped nodal masses [3*n_nodes] (incl. mass scaling)
   double dt = 0;                 // the initial stable step (already times the safety factor)
+  bool erosion = false;          // elements may be eroded: faces they uncover must become surface
 };
 
 /// Force resultant of one reported pair (of contact groups) for history.csv.
@@ -47,7 +48,8 @@ class ContactAlgorithm {
   /// Number of active contacts after the last add_forces (diagnostics).
   virtual std::int64_t active_contacts() const { return 0; }
   /// The hexahedra `mesh_hexes` (indices into Mesh::hexes) were eroded: their faces stop being
-  /// contact segments from the next add_forces on.
+  /// contact segments from the next add_forces on, and the faces of their neighbours that they
+  /// covered start being ones.
   virtual void erode(const std::vector<std::int32_t>& mesh_hexes) { (void)mesh_hexes; }
 };
 

@@ -203,7 +203,8 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   {
     auto X0 = x0.view();
     auto M = mass.view();
-    ContactSetup setup{&model_.mesh, &hex_, X0.data(), M.data(), dt_};
+    ContactSetup setup{&model_.mesh, &hex_, X0.data(),
+                       M.data(),     dt_,   model_.time.erosion_step_ratio > 0};
     for (auto& c : model_.contacts) {
       c->initialise(setup);
       dt_ = std::min(dt_, c->stable_step_limit());

@@ -31,7 +31,7 @@ V3 node_at(const double* x, std::int32_t i) { return V3::at(x + 3 * static_cast<
 
 ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<ContactGroup>& groups,
                                        const double* x0, const std::string& file,
-                                       const std::string& key_prefix) {
+                                       const std::string& key_prefix, bool interior_faces) {
   const std::string key = key_prefix + ".groups";
   const auto n_parts = static_cast<int>(mesh.part_names.size());
   std::vector<int> group_of_part(static_cast<std::size_t>(n_parts), -1);
@@ -81,9 +81,12 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
     for (std::size_t i = 0; i < faces.size();) {
       std::size_t j = i + 1;
       while (j < faces.size() && faces[j].key == faces[i].key) ++j;
-      if (j == i + 1) {  // used by exactly one hexahedron of the group: an outer face
-        const auto& h = mesh.hexes[static_cast<std::size_t>(faces[i].hex)];
-        const int f = faces[i].face;
+      // Used by exactly one hexahedron of the group: an outer face; by two: an inner face, a
+      // segment from each side (dormant until the other hexahedron is eroded).
+      const bool inner = j == i + 2 && interior_faces;
+      for (std::size_t r = i; r < (inner ? i + 2 : (j == i + 1 ? i + 1 : i)); ++r) {
+        const auto& h = mesh.hexes[static_cast<std::size_t>(faces[r].hex)];
+        const int f = faces[r].face;
         V3 c, co;
         for (int k = 0; k < 4; ++k) {
           c += 0.25 * node_at(x0, h[kFace[f][k]]);
@@ -97,9 +100,10 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
         s.seg_group.push_back(static_cast<std::int32_t>(g));
         s.seg_elem_thickness.push_back(std::abs(dot(co - c, n)));
         s.seg_elem_user_id.push_back(mesh.hex_user_id.size() == mesh.hexes.size()
-                                         ? mesh.hex_user_id[static_cast<std::size_t>(faces[i].hex)]
-                                         : faces[i].hex + 1);
-        s.seg_hex.push_back(faces[i].hex);
+                                         ? mesh.hex_user_id[static_cast<std::size_t>(faces[r].hex)]
+                                         : faces[r].hex + 1);
+        s.seg_hex.push_back(faces[r].hex);
+        s.seg_cover_hex.push_back(inner ? faces[r == i ? i + 1 : i].hex : -1);
       }
       i = j;
     }
@@ -127,7 +131,7 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
   for (std::size_t q = 0; q < n_seg; ++q) {
     const V3 a = node_at(x0, s.seg_nodes[4 * q + 2]) - node_at(x0, s.seg_nodes[4 * q]);
     const V3 b = node_at(x0, s.seg_nodes[4 * q + 3]) - node_at(x0, s.seg_nodes[4 * q + 1]);
-    const double area = 0.5 * norm(cross(a, b));
+    const double area = s.seg_cover_hex[q] < 0 ? 0.5 * norm(cross(a, b)) : 0.0;
     for (int k = 0; k < 4; ++k) {
       const auto it = std::lower_bound(uniq.begin(), uniq.end(), keys[4 * q + k]);
       const auto i = static_cast<std::size_t>(it - uniq.begin());

@@ -22,19 +22,25 @@ struct ContactSurface {
       seg_elem_thickness;  // [n_seg] owning hexahedron's thickness normal to the face at x0, m
   std::vector<std::int64_t> seg_elem_user_id;  // [n_seg] for messages
   std::vector<std::int32_t> seg_hex;           // [n_seg] owning hexahedron (index into Mesh::hexes)
+  // [n_seg] -1: an outer face; else an inner face (only with interior_faces), covered by this
+  // hexahedron of the same group: a surface segment only once that one is eroded.
+  std::vector<std::int32_t> seg_cover_hex;
   std::vector<std::int32_t> node;              // [n_snode] mesh node of each surface node
   std::vector<std::int32_t> node_group;        // [n_snode] group of each surface node
-  std::vector<double> node_area;  // [n_snode] tributary area at x0 (quarter of each segment), m^2
+  std::vector<double>
+      node_area;  // [n_snode] tributary area at x0 (quarter of each outer segment), m^2
 
   std::size_t n_segments() const { return seg_group.size(); }
   std::size_t n_nodes() const { return node.size(); }
 };
 
-/// Outer faces of each group (faces used by exactly one hexahedron of the group's parts).
+/// Outer faces of each group (faces used by exactly one hexahedron of the group's parts). With
+/// `interior_faces`, also each face shared by two hexahedra of a group, once from each side (as
+/// the outer face of one, covered by the other), and their nodes: what erosion may uncover.
 /// Throws InputError(file, key_prefix + ".groups", ...) for a part index outside the mesh, a part
 /// without hexahedra, a part listed in two groups, or a group without parts.
 ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<ContactGroup>& groups,
                                        const double* x0, const std::string& file,
-                                       const std::string& key_prefix);
+                                       const std::string& key_prefix, bool interior_faces = false);
 
 }  // namespace ncfsim::fem

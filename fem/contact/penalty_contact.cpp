@@ -26,7 +26,8 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
   const std::string prefix = "contact." + cfg_.name;
   if (!setup.mesh || !setup.x0 || !setup.mass || !(setup.dt > 0))
     throw InputError(cfg_.source_file, prefix, "contact set up without mesh, masses or step");
-  surf_ = extract_contact_surface(*setup.mesh, cfg_.groups, setup.x0, cfg_.source_file, prefix);
+  surf_ = extract_contact_surface(*setup.mesh, cfg_.groups, setup.x0, cfg_.source_file, prefix,
+                                  setup.erosion);
   n_groups_ = cfg_.groups.size();
   const std::size_t ng = n_groups_, n_seg = surf_.n_segments(), n_node = surf_.n_nodes();
   pair_of_.assign(ng * ng, -1);
@@ -57,13 +58,16 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
   inv_dt0_sq_ = 1.0 / (setup.dt * setup.dt);
 
   seg_eroded_.assign(n_seg, 0);
-  active_seg_.clear();
+  seg_dormant_.assign(n_seg, 0);
+  seg_in_pair_.assign(n_seg, 0);
   for (std::size_t s = 0; s < n_seg; ++s) {
     const auto g = static_cast<std::size_t>(surf_.seg_group[s]);
     bool in_pair = false;
     for (std::size_t h = 0; h < ng; ++h) in_pair = in_pair || pair_of_[h * ng + g] >= 0;
-    if (in_pair) active_seg_.push_back(static_cast<std::int32_t>(s));
+    seg_in_pair_[s] = in_pair;
+    seg_dormant_[s] = surf_.seg_cover_hex[s] >= 0;
   }
+  collect_active_segments();
   // Outer faces of the same hexahedron sharing an edge with each segment (the closest-feature
   // test of the narrow phase).
   seg_adjacent_.assign(4 * n_seg, -1);
@@ -128,16 +132,24 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
   sort_segments(setup.x0);
 }
 
+void PenaltyContact::collect_active_segments() {
+  active_seg_.clear();
+  for (std::size_t s = 0; s < seg_in_pair_.size(); ++s)
+    if (seg_in_pair_[s] && !seg_off(s)) active_seg_.push_back(static_cast<std::int32_t>(s));
+}
+
 void PenaltyContact::erode(const std::vector<std::int32_t>& mesh_hexes) {
   std::vector<std::int32_t> gone(mesh_hexes);
   std::sort(gone.begin(), gone.end());
+  auto eroded = [&](std::int32_t h) { return std::binary_search(gone.begin(), gone.end(), h); };
   bool any = false;
-  for (std::size_t s = 0; s < seg_eroded_.size(); ++s)
-    if (!seg_eroded_[s] && std::binary_search(gone.begin(), gone.end(), surf_.seg_hex[s]))
-      seg_eroded_[s] = 1, any = true;
+  for (std::size_t s = 0; s < seg_eroded_.size(); ++s) {
+    if (!seg_eroded_[s] && eroded(surf_.seg_hex[s])) seg_eroded_[s] = 1, any = true;
+    // An inner face whose covering neighbour is gone is outer now (if its own hexahedron stays).
+    if (seg_dormant_[s] && eroded(surf_.seg_cover_hex[s])) seg_dormant_[s] = 0, any = true;
+  }
   if (!any) return;
-  std::erase_if(active_seg_,
-                [&](std::int32_t s) { return seg_eroded_[static_cast<std::size_t>(s)] != 0; });
+  collect_active_segments();
   box_lo_.resize(3 * active_seg_.size());
   box_hi_.resize(3 * active_seg_.size());
   resort_ = true;
@@ -181,6 +193,7 @@ bool PenaltyContact::closer_adjacent_face(const double* x, const std::int32_t* a
   const double thick = cfg_.thickness;
   for (int a = 0; a < 4 && adj[a] >= 0; ++a) {
     const auto q = static_cast<std::size_t>(adj[a]);
+    if (seg_off(q)) continue;  // not a face of the surface (yet, or any more)
     // Made here: the test runs only on a hit of a segment with outer neighbours in its own
     // hexahedron that beats the node's best so far. The normal (along the cross product of the
     // diagonals, as a1 x a2 = d1 x d2 / 8) decides first whether the face matters at all.
@@ -246,7 +259,7 @@ void PenaltyContact::sort_segments(const double* x) {
     int nf = 0;
     for (std::int32_t r = node_seg_start_[e]; r < node_seg_start_[e + 1]; ++r) {
       const auto q = static_cast<std::size_t>(node_seg_[static_cast<std::size_t>(r)]);
-      if (seg_eroded_[q]) continue;  // a node left without segments faces nothing
+      if (seg_off(q)) continue;  // a node left without segments (or inside) faces nothing
       const double* n = frame_[q].n;
       int best = -1;
       double best_dot = -2;

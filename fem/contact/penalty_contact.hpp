@@ -78,7 +78,8 @@ class PenaltyContact final : public ContactAlgorithm {
   double friction_dissipation() const override { return dissipation_; }
   std::vector<ContactResultant> resultants() const override;
   std::int64_t active_contacts() const override { return stats_.n_active; }
-  /// Faces of eroded hexahedra leave the surface (faces they uncover are not added).
+  /// Faces of eroded hexahedra leave the surface; the faces of their neighbours in the same group
+  /// that they covered join it (set up when the solver erodes: ContactSetup::erosion).
   void erode(const std::vector<std::int32_t>& mesh_hexes) override;
 
   const PenaltyContactConfig& config() const { return cfg_; }
@@ -155,6 +156,11 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<std::int32_t> node_seg_start_, node_seg_;  // segments around each surface node (CSR)
   std::vector<std::int32_t> active_seg_;  // [n_seg] index into segs of the grid (active groups)
   std::vector<std::uint8_t> seg_eroded_;  // [n_seg] 1: its hexahedron was eroded
+  std::vector<std::uint8_t> seg_dormant_;  // [n_seg] 1: an inner face still covered (erosion)
+  std::vector<std::uint8_t> seg_in_pair_;  // [n_seg] 1: its group is in a pair
+  /// Rebuilds active_seg_: segments of paired groups neither eroded nor dormant.
+  void collect_active_segments();
+  bool seg_off(std::size_t s) const { return seg_eroded_[s] || seg_dormant_[s]; }
   bool resort_ = false;                   // the surface changed: sort before the next cycle
   BucketGrid grid_;
 

@@ -7,14 +7,13 @@
 // stays below the critical step of a compacted, sheared tow element (finite-difference tangent).
 #include <gtest/gtest.h>
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <utility>
 #include <vector>
 
 #include "drape/tow_material.hpp"
-#include "fem/hex8_block.hpp"
 #include "fem/solver.hpp"
+#include "tests/hex8_critical_step.hpp"
 #include "tests/test_support.hpp"
 
 using namespace ncfsim;
@@ -255,58 +254,23 @@ namespace {
 // stiffness included; hourglass viscosity off), and the engine's estimate in that shape.
 std::pair<double, double> compacted_tow_steps(const drape::TowMaterial& mat, double sy, double sz,
                                               double shear) {
-  const double L[3] = {3.32e-3, 1.61e-3, 0.23e-3};
-  const int corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                            {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-  std::vector<double> x0, xd;
-  for (const auto& c : corner) {
-    const double X = c[0] * L[0], Y = c[1] * L[1], Z = c[2] * L[2];
-    x0.insert(x0.end(), {X, Y, Z});
-    xd.insert(xd.end(), {X + shear * Y, sy * Y, sz * Z});
-  }
-  fem::Hex8Block b;
-  b.material = &mat;
-  b.n = 1;
-  for (int I = 0; I < 8; ++I) b.conn.push_back(I);
-  b.user_id = {1};
-  b.mesh_hex = {0};
-  b.hourglass_viscosity = 0;
-  fem::hex8_initialise(b, x0.data(), {1, 0, 0, 0, 1, 0, 0, 0, 1});
-  std::vector<double> x = x0, v(24), f(24);
+  auto h = test::one_hex(mat, {3.32e-3, 0, 0}, {0, 1.61e-3, 0}, {0, 0, 0.23e-3});
+  const std::vector<double> x0 = h.x;
+  std::vector<double> v(24), f(24);
   fem::ElementEnergyIncrement inc;
   fem::StableStep st;
   const int steps = 200;
   for (int k = 1; k <= steps; ++k) {
-    for (std::size_t d = 0; d < 24; ++d) {
-      const double xn = x0[d] + (xd[d] - x0[d]) * k / steps;
-      v[d] = xn - x[d], x[d] = xn;  // over a unit step
+    for (std::size_t I = 0; I < 8; ++I) {
+      const double X = x0[3 * I], Y = x0[3 * I + 1], Z = x0[3 * I + 2],
+                   s = static_cast<double>(k) / steps;
+      const double xn[3] = {X + s * shear * Y, Y + s * (sy - 1) * Y, Z + s * (sz - 1) * Z};
+      for (std::size_t c = 0; c < 3; ++c)
+        v[3 * I + c] = xn[c] - h.x[3 * I + c], h.x[3 * I + c] = xn[c];
     }
-    fem::hex8_internal_forces(b, x.data(), v.data(), 1.0, f.data(), inc, st);
+    fem::hex8_internal_forces(h.block, h.x.data(), v.data(), 1.0, f.data(), inc, st);  // unit step
   }
-  auto forces = [&](const std::vector<double>& xp, const std::vector<double>& vp) {
-    fem::Hex8Block c = b;
-    std::vector<double> fp(24, 0.0);
-    fem::hex8_internal_forces(c, xp.data(), vp.data(), 1.0, fp.data(), inc, st);
-    return fp;
-  };
-  const std::vector<double> f0 = forces(x, std::vector<double>(24, 0.0));
-  const double eps = 1e-9;
-  Eigen::MatrixXd K(24, 24);
-  for (std::size_t j = 0; j < 24; ++j) {
-    std::vector<double> xp = x, vp(24, 0.0);
-    xp[j] += eps, vp[j] = eps;
-    const auto fp = forces(xp, vp);
-    for (std::size_t i = 0; i < 24; ++i)
-      K(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = -(fp[i] - f0[i]) / eps;
-  }
-  const double m = b.density[0] * b.volume0[0] / 8;
-  const Eigen::MatrixXd Ks = 0.5 * (K + K.transpose()) / m;
-  const double w2 = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Ks, Eigen::EigenvaluesOnly)
-                        .eigenvalues()
-                        .maxCoeff();
-  std::vector<double> dt;
-  fem::hex8_element_steps(b, x.data(), dt);
-  return {2.0 / std::sqrt(w2), dt[0]};
+  return {test::critical_step(h), test::estimated_step(h)};
 }
 }  // namespace
 

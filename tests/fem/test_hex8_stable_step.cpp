@@ -8,72 +8,19 @@
 // with turned fibre axes; for a tow-like element (stiff along its length, soft and thin across)
 // the characteristic length V / A_max with the largest modulus alone would be 5 times too small.
 // Isotropic elements keep the Flanagan-Belytschko bound: exact on a cube, safe on a plate.
-#include <Eigen/Eigenvalues>
 #include <array>
 #include <cmath>
 #include <vector>
 
-#include "fem/hex8_block.hpp"
-#include "fem/material.hpp"
+#include "tests/hex8_critical_step.hpp"
 #include "tests/test_support.hpp"
 
 using namespace ncfsim;
 
 namespace {
 
-struct OneHex {
-  std::vector<double> x;  // [8][3]
-  fem::Hex8Block block;
-};
-
-// Parallelepiped from the origin spanned by the edges e1, e2, e3 (VTK node order).
-OneHex make_hex(const fem::SolidMaterial& mat, const std::array<double, 3>& e1,
-                const std::array<double, 3>& e2, const std::array<double, 3>& e3,
-                const std::array<double, 9>& axes) {
-  OneHex h;
-  const int corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                            {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-  for (const auto& c : corner)
-    for (int r = 0; r < 3; ++r) h.x.push_back(c[0] * e1[r] + c[1] * e2[r] + c[2] * e3[r]);
-  auto& b = h.block;
-  b.material = &mat;
-  b.n = 1;
-  for (int I = 0; I < 8; ++I) b.conn.push_back(I);
-  b.user_id = {1};
-  b.mesh_hex = {0};
-  b.hourglass_viscosity = 0.0;
-  fem::hex8_initialise(b, h.x.data(), axes);
-  return h;
-}
-
-// Critical step 2 / omega_max of the element from its finite-difference stiffness.
-double critical_step(const OneHex& h) {
-  const double scale = std::cbrt(h.block.volume0[0]);
-  const double eps = 1e-7 * scale;
-  Eigen::MatrixXd K(24, 24);
-  for (int j = 0; j < 24; ++j) {
-    fem::Hex8Block b = h.block;  // fresh state: the step from the reference is the whole increment
-    std::vector<double> x = h.x, v(24, 0.0), f(24, 0.0);
-    x[static_cast<std::size_t>(j)] += eps;
-    v[static_cast<std::size_t>(j)] = eps;  // over a unit step
-    fem::ElementEnergyIncrement inc;
-    fem::StableStep st;
-    fem::hex8_internal_forces(b, x.data(), v.data(), 1.0, f.data(), inc, st);
-    for (int i = 0; i < 24; ++i) K(i, j) = -f[static_cast<std::size_t>(i)] / eps;
-  }
-  const Eigen::MatrixXd Ks = 0.5 * (K + K.transpose());
-  const double m = h.block.density[0] * h.block.volume0[0] / 8.0;
-  const double w2 = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Ks / m, Eigen::EigenvaluesOnly)
-                        .eigenvalues()
-                        .maxCoeff();
-  return 2.0 / std::sqrt(w2);
-}
-
-double estimated_step(const OneHex& h) {
-  std::vector<double> dt;
-  fem::hex8_element_steps(h.block, h.x.data(), dt);
-  return dt[0];
-}
+using test::critical_step;
+using test::estimated_step;
 
 constexpr std::array<double, 9> kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
 
@@ -81,7 +28,7 @@ constexpr std::array<double, 9> kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
 
 TEST(Hex8StableStep, IsotropicCubeIsSafe) {
   fem::ElasticIsotropic steel("steel", 7800, 210e9, 0.3);
-  const auto h = make_hex(steel, {1e-3, 0, 0}, {0, 1e-3, 0}, {0, 0, 1e-3}, kIdentity);
+  const auto h = test::one_hex(steel, {1e-3, 0, 0}, {0, 1e-3, 0}, {0, 0, 1e-3}, kIdentity);
   const double exact = critical_step(h), est = estimated_step(h);
   EXPECT_LE(est, exact * (1 + 1e-6));
   EXPECT_GE(est, 0.99 * exact);
@@ -91,7 +38,7 @@ TEST(Hex8StableStep, ThinIsotropicPlateKeepsTheFlanaganBelytschkoMargin) {
   // Isotropic elements keep V/A_max over sqrt(3K/rho): 0.69 of the critical step of a thin plate
   // element (penalty contacts use that margin, fem/contact/README.md).
   fem::ElasticIsotropic steel("steel", 7800, 210e9, 0.3);
-  const auto h = make_hex(steel, {10e-3, 0, 0}, {0, 8e-3, 0}, {0, 0, 1e-3}, kIdentity);
+  const auto h = test::one_hex(steel, {10e-3, 0, 0}, {0, 8e-3, 0}, {0, 0, 1e-3}, kIdentity);
   const double exact = critical_step(h), est = estimated_step(h);
   EXPECT_LE(est, exact * (1 + 1e-6));
   EXPECT_GE(est, 0.6 * exact);
@@ -103,7 +50,7 @@ TEST(Hex8StableStep, OrthotropicTowElementUsesItsLengthForTheFibreModulus) {
   // (20 GPa) against a soft transverse phase (0.1 GPa).
   fem::ElasticOrthotropic tow("tow", 1080,
                               {20e9, 0.1e9, 0.1e9, 0.0, 0.0, 0.0, 0.05e9, 0.05e9, 0.05e9});
-  const auto h = make_hex(tow, {3.3e-3, 0, 0}, {0, 1.65e-3, 0}, {0, 0, 0.15e-3}, kIdentity);
+  const auto h = test::one_hex(tow, {3.3e-3, 0, 0}, {0, 1.65e-3, 0}, {0, 0, 0.15e-3}, kIdentity);
   const double exact = critical_step(h), est = estimated_step(h);
   EXPECT_LE(est, exact * (1 + 1e-6));
   EXPECT_GE(est, 0.99 * exact);
@@ -118,7 +65,7 @@ TEST(Hex8StableStep, ShearedRotatedOrthotropicElementIsSafe) {
                               {20e9, 0.1e9, 0.1e9, 0.2, 0.2, 0.3, 0.05e9, 0.05e9, 0.05e9});
   const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
   const std::array<double, 9> axes{c, -s, 0, s, c, 0, 0, 0, 1};
-  const auto h = make_hex(tow, {3e-3, 0, 0}, {1e-3, 1.7e-3, 0}, {0, 0, 0.2e-3}, axes);
+  const auto h = test::one_hex(tow, {3e-3, 0, 0}, {1e-3, 1.7e-3, 0}, {0, 0, 0.2e-3}, axes);
   const double exact = critical_step(h), est = estimated_step(h);
   EXPECT_LE(est, exact * (1 + 1e-6));
   EXPECT_GE(est, 0.99 * exact);
@@ -127,7 +74,7 @@ TEST(Hex8StableStep, ShearedRotatedOrthotropicElementIsSafe) {
 TEST(Hex8StableStep, KernelReportsTheSameStep) {
   fem::ElasticOrthotropic tow("tow", 1080,
                               {20e9, 0.1e9, 0.1e9, 0.0, 0.0, 0.0, 0.05e9, 0.05e9, 0.05e9});
-  auto h = make_hex(tow, {3.3e-3, 0, 0}, {0, 1.65e-3, 0}, {0, 0, 0.15e-3}, kIdentity);
+  auto h = test::one_hex(tow, {3.3e-3, 0, 0}, {0, 1.65e-3, 0}, {0, 0, 0.15e-3}, kIdentity);
   std::vector<double> v(24, 0.0), f(24, 0.0);
   fem::ElementEnergyIncrement inc;
   fem::StableStep st;
