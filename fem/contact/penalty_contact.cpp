@@ -68,8 +68,8 @@ void PenaltyContact::initialise(const ContactSetup& setup) {
     seg_dormant_[s] = surf_.seg_cover_hex[s] >= 0;
   }
   collect_active_segments();
-  // Outer faces of the same hexahedron sharing an edge with each segment (the closest-feature
-  // test of the narrow phase).
+  // Faces of the same hexahedron sharing an edge with each segment (the closest-feature test of
+  // the narrow phase; dormant inner faces among them are skipped there until uncovered).
   seg_adjacent_.assign(4 * n_seg, -1);
   {
     std::vector<std::int32_t> by_hex(n_seg);

@@ -114,7 +114,7 @@ class PenaltyContact final : public ContactAlgorithm {
   double margin_ = 0;                  // search margin, m
   double inv_dt0_sq_ = 0;              // 1 / dt0^2
   std::vector<double> depth_;          // [n_seg] max_penetration * element thickness
-  std::vector<std::int32_t> seg_adjacent_;  // [n_seg][4] outer faces of the same hexahedron
+  std::vector<std::int32_t> seg_adjacent_;  // [n_seg][4] surface faces of the same hexahedron
                                             // sharing an edge, -1 padded
 
   // State and work arrays, sized in initialise(), reused every cycle.
