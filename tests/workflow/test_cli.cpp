@@ -80,6 +80,18 @@ TEST(Cli, SetOverridesAreCheckedLikeTheFile) {
   }
   r = run_cli({"check", c.string(), "--set", "time.erosion_step_ratio=0.3"});
   EXPECT_EQ(r.code, 0) << r.output;
+  // A tow whose stretch has its own modulus bends with E11f only with one hexahedron through it.
+  const fs::path be = kSource / "cases/drape/bias_extension_positive.toml";
+  r = run_cli({"check", be.string(), "--set", "material[0].E11f_axial=5e9", "--set",
+               "mesh.fabric[0].elements_through_thickness=2"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("elements_through_thickness"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("E11f_axial"), std::string::npos) << r.output;
+  r = run_cli({"check", be.string(), "--set", "material[0].E11f_axial=5e9"});
+  EXPECT_EQ(r.code, 0) << r.output;
+  r = run_cli({"check", be.string(), "--set", "material[0].E11f_axial=-1"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("E11f_axial"), std::string::npos) << r.output;
 }
 
 // Regression: the default case through the CLI reproduces Euler-Bernoulli within 5 %.

@@ -410,6 +410,7 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
   struct FabricEntry {
     std::string name, tow_material, law_I, law_Lambda, law_legs;
     std::vector<double> angles;
+    int elements_through_thickness = 1;
     drape::FabricModel model;
     drape::StitchConnectionSettings connection;
     std::string path;
@@ -457,6 +458,7 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       fe.connection.stiffness = fb.number("connection_stiffness", 0.0, Range::non_negative());
     }
     fe.angles = f.ply_angles_deg;
+    fe.elements_through_thickness = f.elements_through_thickness;
     drape::validate(f, fname, fb.path());
     if (!(bl.size[0] >= f.tow_pitch() * (1 - 1e-9) && bl.size[1] >= f.tow_pitch() * (1 - 1e-9)))
       fb.fail("size", "the blanket must be at least one tow pitch (" + std::to_string(f.tow_pitch()) + " m) long and wide");
@@ -524,6 +526,17 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       return names.at(n);
     };
     const int tow = need(materials, fe.tow_material, "tow_material");
+    // E11f_axial leaves bending to E11f through the hourglass moduli, which carry all of the
+    // bending only with one hexahedron through the tow: with more, the layers' stretch (E11f_axial)
+    // would bend it.
+    const auto* tow_law = dynamic_cast<const drape::TowMaterial*>(
+        ec.model.materials[static_cast<std::size_t>(tow)].get());
+    if (tow_law && tow_law->constants().E11f_axial > 0 && fe.elements_through_thickness > 1)
+      throw InputError(fname, fe.path + ".elements_through_thickness",
+                       "must be 1 with tow material '" + fe.tow_material +
+                           "', which sets E11f_axial (its bending stiffness, E11f, is separate "
+                           "from its stretch only with "
+                           "one hexahedron through the tow thickness)");
     for (std::size_t q = 0; q < fe.model.ply_parts.size(); ++q) {
       auto& pp = ec.model.parts[static_cast<std::size_t>(fe.model.ply_parts[q])];
       pp.kind = fem::PartProperties::Kind::Solid;
