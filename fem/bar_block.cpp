@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "fem/errors.hpp"
@@ -79,6 +80,22 @@ void bar_lumped_mass(const BarBlock& b, double* mass) {
   }
 }
 
+// Names the first bar whose force or strain is not finite, with its mid-point (the blow-up report).
+[[noreturn]] void throw_non_finite_bar(const BarBlock& b, const double* x) {
+  for (std::size_t e = 0; e < b.n; ++e) {
+    if (std::isfinite(b.force[e]) && std::isfinite(b.strain[e])) continue;
+    const auto i = 3 * static_cast<std::size_t>(b.conn[e]),
+               j = 3 * static_cast<std::size_t>(b.conn[b.n + e]);
+    std::ostringstream os;
+    os << "bar " << b.user_id[e] << " (part " << b.part << ") has a non-finite force at ("
+       << 0.5 * (x[i] + x[j]) << ", " << 0.5 * (x[i + 1] + x[j + 1]) << ", "
+       << 0.5 * (x[i + 2] + x[j + 2]) << ") m";
+    throw NumericalError(os.str());
+  }
+  throw NumericalError("bar part " + std::to_string(b.part) +
+                       " produced a non-finite work increment");
+}
+
 void bar_internal_forces(BarBlock& b, const double* x, double* f, ElementEnergyIncrement& energy,
                          StableStep& step) {
   // Batched: W bars per SIMD register for the strain, law and force; the node gathers are per
@@ -148,8 +165,7 @@ void bar_internal_forces(BarBlock& b, const double* x, double* f, ElementEnergyI
     }
   }
   const double wsum = stdx::reduce(w);
-  if (!std::isfinite(wsum))
-    throw NumericalError("bar part " + std::to_string(b.part) + " produced a non-finite force");
+  if (!std::isfinite(wsum)) throw_non_finite_bar(b, x);
   energy.internal += wsum;
 }
 

@@ -68,3 +68,36 @@ TEST(Bar, CompressionCarriedWhenNotTensionOnly) {
   const auto r = drive_bar(-0.001, false, 1e-4);
   EXPECT_TRUE(test::near_rel(r.force, -1.0, 0.02));
 }
+
+// A blow-up is reported with the bar's id and position (never a NaN run): one node of a bar
+// block at a non-finite position makes the force pass throw NumericalError naming the bar.
+TEST(Bar, NonFiniteForceNamesTheBarAndWhere) {
+  fem::Model model;
+  const int p = model.mesh.add_part("stitch");
+  model.mesh.coords = {0, 0, 0, 0.01, 0, 0, 0.02, 0.002, 0};
+  model.mesh.bars = {{0, 1}, {1, 2}};
+  model.mesh.bar_part = {p, p};
+  model.bar_laws.push_back(fem::BarForceLaw::linear("yarn", 100.0, true, 1e-4));
+  model.parts.resize(1);
+  model.parts[0].kind = fem::PartProperties::Kind::Bar;
+  model.parts[0].bar_law = 0;
+  model.time.end_time = 1;
+  fem::ExplicitSolver solver(model);
+  fem::BarBlock b = solver.bar_blocks().at(0);
+  ASSERT_EQ(b.n, 2u);
+  std::vector<double> x = model.mesh.coords, f(x.size(), 0.0);
+  x[6] = std::nan("");  // node 2 is lost: the second bar's force is not finite
+  fem::ElementEnergyIncrement energy;
+  fem::StableStep step;
+  try {
+    fem::bar_internal_forces(b, x.data(), f.data(), energy, step);
+    FAIL() << "no NumericalError";
+  } catch (const NumericalError& e) {
+    const std::string msg = e.what();
+    const std::size_t lost = b.conn[0] == 2 || b.conn[b.n] == 2 ? 0 : 1;  // the bar on node 2
+    const std::int64_t id = b.user_id[lost];
+    EXPECT_NE(msg.find("bar " + std::to_string(id) + " (part 0) has a non-finite force at ("),
+              std::string::npos)
+        << msg;
+  }
+}

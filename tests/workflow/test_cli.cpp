@@ -212,6 +212,24 @@ TEST(Cli, ErosionIsReportedEverywhere) {
   fs::remove_all(out);
 }
 
+// A run stopped by a non-finite state writes its energies as null in summary.json: its report
+// is still written, saying so.
+TEST(Cli, ReportOfARunThatBlewUp) {
+  const fs::path out = fresh_dir("blown_up");
+  fs::create_directories(out);
+  std::ofstream(out / "summary.json") << R"({"case": "blown", "status": "numerical_failure",
+    "error": "bar 17 (part 3) has a non-finite force at (0.1, 0.2, 0) m",
+    "energy_balance_error": null, "energy_balance_limit": 0.05, "kinetic_energy_J": null})";
+  const Result r = run_cli({"report", out.string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string html = slurp(out / "report.html");
+  EXPECT_NE(html.find("energy balance error <span class=\"bad\">not finite</span>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("bar 17 (part 3) has a non-finite force"), std::string::npos);
+  fs::remove_all(out);
+}
+
 TEST(Cli, CalibrateStitchRoundTrip) {
   const fs::path dir = fresh_dir("calibrate");
   fs::create_directories(dir);

@@ -1,10 +1,10 @@
 #include "workflow/report/report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "workflow/run/run_output.hpp"
 
@@ -43,6 +43,14 @@ void flatten(const nlohmann::json& j, const std::string& prefix, std::vector<std
   }
 }
 
+// A number of the summary, NaN where it is missing or null (a run stopped by a non-finite state
+// writes its energies as null).
+double summary_number(const nlohmann::json& s, const char* key, double missing) {
+  const auto it = s.find(key);
+  if (it == s.end()) return missing;
+  return it->is_number() ? it->get<double>() : std::nan("");
+}
+
 }  // namespace
 
 void write_report(const std::filesystem::path& dir) {
@@ -58,11 +66,16 @@ void write_report(const std::filesystem::path& dir) {
        ".bad{color:#b00;font-weight:bold}.ok{color:#070;font-weight:bold}</style></head><body>\n";
   h << "<h1>" << escape(name) << "</h1>\n";
   const std::string status = s.value("status", "unknown");
-  const double err = s.value("energy_balance_error", 0.0), lim = s.value("energy_balance_limit", 0.05);
-  h << "<p>ncfsim " << escape(s.value("ncfsim_version", "?")) << " &middot; stage " << escape(s.value("stage", "?"))
-    << " &middot; status <span class=\"" << (status == "completed" ? "ok" : "bad") << "\">" << escape(status)
-    << "</span> &middot; energy balance error <span class=\"" << (err <= lim ? "ok" : "bad") << "\">"
-    << escape(nlohmann::json(100 * err).dump()) << " %</span> (limit " << 100 * lim << " %)</p>\n";
+  const double err = summary_number(s, "energy_balance_error", 0.0);
+  const double lim = summary_number(s, "energy_balance_limit", 0.05);
+  h << "<p>ncfsim " << escape(s.value("ncfsim_version", "?")) << " &middot; stage "
+    << escape(s.value("stage", "?")) << " &middot; status <span class=\""
+    << (status == "completed" ? "ok" : "bad") << "\">" << escape(status)
+    << "</span> &middot; energy balance error <span class=\"" << (err <= lim ? "ok" : "bad")
+    << "\">"
+    << (std::isfinite(err) ? escape(nlohmann::json(100 * err).dump()) + " %"
+                           : std::string("not finite"))
+    << "</span> (limit " << 100 * lim << " %)</p>\n";
   if (s.contains("error")) h << "<p class=\"bad\">" << escape(s["error"].get<std::string>()) << "</p>\n";
 
   std::vector<std::filesystem::path> figs;
