@@ -40,6 +40,8 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   if (!(Lx >= p * (1 - 1e-9) && Ly >= p * (1 - 1e-9)))
     throw InputError(file, prefix + "size", "the blanket must be at least one tow pitch long and wide");
   FabricModel fm;
+  // Per tow node: its next node along the tow, same face (the connections' tow axis).
+  std::vector<std::int32_t> axis_neighbour;
   fm.tow_thickness = t;
   const std::array<double, 2> lo{bl.origin[0], bl.origin[1]}, hi{bl.origin[0] + Lx, bl.origin[1] + Ly};
   // Penetration lattice: along the wales m (the stitch direction) every s, across them n every g,
@@ -116,6 +118,12 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
           }
         }
       auto node = [&](int i, int m, int kz) { return base + (kz * (nw + 1) + m) * (nl + 1) + i; };
+      axis_neighbour.resize(mesh.n_nodes(), -1);
+      for (int kz = 0; kz <= nt; ++kz)
+        for (int m = 0; m <= nw; ++m)
+          for (int i = 0; i <= nl; ++i)
+            axis_neighbour[static_cast<std::size_t>(node(i, m, kz))] =
+                node(i < nl ? i + 1 : i - 1, m, kz);
       for (int kz = 0; kz <= nt; ++kz) {
         fm.tow_end_pins.push_back(node(0, nw / 2, kz));
         fm.tow_end_pins.push_back(node(nl, nw / 2, kz));
@@ -237,7 +245,9 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
           if (!fresh && d < it2->second.first) it2->second = {d, nd};
         }
       }
-    for (const auto& [tow, dn] : best) fm.connections.push_back({sn, dn.second});
+    for (const auto& [tow, dn] : best)
+      fm.connections.push_back(
+          {sn, dn.second, axis_neighbour[static_cast<std::size_t>(dn.second)]});
   }
   return fm;
 }

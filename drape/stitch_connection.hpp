@@ -1,10 +1,15 @@
 #pragma once
-// Stitch-to-tow connection elements: each joins a stitch node to a tow node with an elastic spring
-// up to a sliding force, beyond which the stitch slides on the tow (a frictional slider, the force
-// stays at the sliding force; the slip and the energy it dissipates are tracked). The sliding force
-// comes from the tow pull-out test. Implemented as a contact of the engine: its forces go to the
-// contact forces, the spring energy and the slip work into the contact energy, the slip work also
-// into friction_dissipation.
+// Stitch-to-tow connection elements: each joins a stitch node to a tow node with an elastic spring.
+// Along the tow the spring holds up to a sliding force, beyond which the tow slides past the stitch
+// (a frictional slider: the force stays at the sliding force, the slip and the energy it dissipates
+// are tracked; the sliding force comes from the tow pull-out test). Across the tow the spring stays
+// elastic up to a transverse force: the yarn lies in the gap between two tows and bears on their
+// sides, so a tow does not slip sideways past it at the pull-out force. The spring's rest offset
+// turns with the tow's axis (the smallest rotation from its set-up direction), so a turning tow
+// loads no joint; the forces are the gradient of the spring energy, including those on the tow
+// node that gives the axis (docs/theory.md, "Stitch-to-tow connection"). Implemented as a contact
+// of the engine: its forces go to the contact forces, the spring energy and the slip work into the
+// contact energy, the slip work also into friction_dissipation.
 #include <string>
 #include <vector>
 
@@ -14,7 +19,8 @@
 namespace ncfsim::drape {
 
 struct StitchConnectionSettings {
-  double sliding_force = 0.05;    // N per connection (> 0), docs/fabric-data.md
+  double sliding_force = 0.05;     // N per connection (> 0) along the tow, docs/fabric-data.md
+  double transverse_force = 0.15;  // N, across the tow (in and out of the ply); 0: no limit
   double stiffness = 0;           // N/m; 0: the stability limit below
   double stiffness_scale = 0.1;   // k <= scale * min(m_a, m_b) / dt^2: never lowers the stable step
 };
@@ -28,8 +34,13 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   double friction_dissipation() const override { return dissipated_; }
   std::int64_t active_contacts() const override { return n_sliding_; }
   std::vector<fem::ContactResultant> resultants() const override;
+  /// A joint whose tow edge (tow node to axis node) was in eroded hexahedra only is released:
+  /// its tow piece is gone, and its two nodes, no longer held together, would not give an axis.
+  void erode(const std::vector<std::int32_t>& mesh_hexes) override;
+  /// Joints released by erosion so far.
+  std::size_t released() const { return n_released_; }
 
-  /// Slip of each connection so far (m), for output and tests.
+  /// Slip of each connection so far (m, the slider's path length), for output and tests.
   double slip_length(std::size_t i) const { return slip_len_[i]; }
   double force_magnitude(std::size_t i) const { return force_[i]; }
   /// Spring stiffness in use (N/m): the requested one, capped by the stability limit.
@@ -40,10 +51,16 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   std::string name_;
   StitchConnectionSettings s_;
   std::vector<std::int32_t> a_, b_;     // stitch node, tow node
-  std::vector<double> d0_;              // [3*n] reference offset b - a
-  std::vector<double> slip_;            // [3*n] slider position
+  std::vector<std::int32_t> ax_;        // the tow's next node from b along it
+  std::vector<double> t0_;              // [3*n] tow axis at set-up (unit)
+  std::vector<double> rest_;            // [3*n] rest offset b - a with the slip, set-up frame
   std::vector<double> k_;               // [n]
   std::vector<double> force_, slip_len_;
+  // Live hexahedra holding each joint's tow edge (0: released), and the joints whose tow edge each
+  // hexahedron holds (CSR by mesh hexahedron).
+  std::vector<std::int32_t> edge_hexes_;
+  std::vector<std::int32_t> hex_joint_start_, hex_joints_;
+  std::size_t n_released_ = 0;
   double dissipated_ = 0;
   std::int64_t n_sliding_ = 0;
   fem::V3 total_{};

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "drape/fabric_generator.hpp"
@@ -123,11 +124,23 @@ TEST_P(StitchJoints, EveryStitchBarIsJoinedAtBothEnds) {
   // each other there.
   std::map<std::int32_t, int> per_node;
   std::map<std::int32_t, std::set<int>> plies_of_node;
-  std::map<std::int32_t, int> ply_of_node;
+  std::map<std::int32_t, int> ply_of_node, tow_of_node;
   for (std::size_t e = 0; e < b.mesh.hexes.size(); ++e)
-    for (auto nd : b.mesh.hexes[e])
+    for (auto nd : b.mesh.hexes[e]) {
       ply_of_node[nd] = b.fm.ply_of_tow[static_cast<std::size_t>(b.fm.tow_of_hex[e])];
+      tow_of_node[nd] = b.fm.tow_of_hex[e];
+    }
   for (const auto& c : b.fm.connections) {
+    // The joint's tow axis: the next node of the tow node along its tow, on its face, in the
+    // ply's fibre direction.
+    const auto& P = b.mesh.coords;
+    const double al =
+        f.ply_angles_deg[static_cast<std::size_t>(ply_of_node.at(c.tow_node))] * M_PI / 180;
+    const std::int32_t nb = c.tow_axis_node;
+    ASSERT_EQ(tow_of_node.at(nb), tow_of_node.at(c.tow_node));
+    EXPECT_NEAR(P[3 * nb + 2], P[3 * c.tow_node + 2], 1e-12);
+    const double dx = P[3 * nb] - P[3 * c.tow_node], dy = P[3 * nb + 1] - P[3 * c.tow_node + 1];
+    EXPECT_NEAR(std::abs(dx * std::cos(al) + dy * std::sin(al)) / std::hypot(dx, dy), 1.0, 1e-9);
     ++per_node[c.stitch_node];
     plies_of_node[c.stitch_node].insert(ply_of_node.at(c.tow_node));
     const auto& X = b.mesh.coords;

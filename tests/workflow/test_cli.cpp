@@ -92,6 +92,10 @@ TEST(Cli, SetOverridesAreCheckedLikeTheFile) {
   r = run_cli({"check", be.string(), "--set", "material[0].E11f_axial=-1"});
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("E11f_axial"), std::string::npos) << r.output;
+  r = run_cli({"check", be.string(), "--set", "mesh.fabric[0].connection_transverse_force=-0.1"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("mesh.fabric[0].connection_transverse_force"), std::string::npos)
+      << r.output;
 }
 
 // Regression: the default case through the CLI reproduces Euler-Bernoulli within 5 %.

@@ -455,6 +455,8 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       fe.law_Lambda = f.stitch == drape::StitchPattern::Tricot ? fb.string("stitch_law_Lambda") : fe.law_I;
       fe.law_legs = fb.string("stitch_law_legs", fe.law_I);
       fe.connection.sliding_force = fb.number("connection_sliding_force", 0.05, Range::positive());
+      fe.connection.transverse_force = fb.number(
+          "connection_transverse_force", 3 * fe.connection.sliding_force, Range::non_negative());
       fe.connection.stiffness = fb.number("connection_stiffness", 0.0, Range::non_negative());
     }
     fe.angles = f.ply_angles_deg;
@@ -473,7 +475,8 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
   const auto new_of_old = fem::renumber_for_locality(mesh);
   for (auto& fe : fabrics) {
     for (auto& c : fe.model.connections)
-      c.stitch_node = new_of_old[static_cast<std::size_t>(c.stitch_node)], c.tow_node = new_of_old[static_cast<std::size_t>(c.tow_node)];
+      for (std::int32_t* nd : {&c.stitch_node, &c.tow_node, &c.tow_axis_node})
+        *nd = new_of_old[static_cast<std::size_t>(*nd)];
     for (auto& nd : fe.model.stitch_nodes) nd = new_of_old[static_cast<std::size_t>(nd)];
     for (auto& nd : fe.model.tow_end_pins) nd = new_of_old[static_cast<std::size_t>(nd)];
     g_tow_end_pins[fe.name] = fe.model.tow_end_pins;
