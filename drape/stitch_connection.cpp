@@ -53,9 +53,10 @@ struct TowTurn {
   }
 };
 
-inline TowTurn tow_turn(const double* x, std::size_t b, std::size_t c, const double* t0) {
+// The turn from t0 to the direction of u.
+inline TowTurn tow_turn(const double* u, const double* t0) {
   TowTurn r;
-  for (std::size_t k = 0; k < 3; ++k) r.t[k] = x[3 * c + k] - x[3 * b + k], r.t0[k] = t0[k];
+  for (std::size_t k = 0; k < 3; ++k) r.t[k] = u[k], r.t0[k] = t0[k];
   r.len_u = std::sqrt(dot(r.t, r.t));
   for (double& v : r.t) v /= r.len_u;
   r.c = dot(t0, r.t);
@@ -84,45 +85,70 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
   force_.assign(n, 0.0);
   slip_len_.assign(n, 0.0);
   const double* x0 = setup.x0;
-  // Hexahedra holding each joint's tow edge (b, c), both ways (CSR by hexahedron).
+  // The tow's axis at a joint is the axis of a hexahedron holding its tow edge (b, c): the mean
+  // of its four edges along the tow, u = sum_I w_I x_I with w_I = +-1/8 at its two ends. The
+  // turn of the offset with it then moves the hexahedron as a whole (no hourglass couple on
+  // one edge). Joints by hexahedron (CSR) for the release on erosion.
+  const auto& hexes = setup.mesh->hexes;
+  hex8_.assign(8 * n, 0);
+  w8_.assign(8 * n, 0.0);
+  live_.assign(n, 0);
   {
-    const auto& hexes = setup.mesh->hexes;
-    std::vector<std::vector<std::int32_t>> joints_at(nn);  // joints by tow node b
-    for (std::size_t i = 0; i < n; ++i)
-      if (b_[i] >= 0 && static_cast<std::size_t>(b_[i]) < nn)
-        joints_at[static_cast<std::size_t>(b_[i])].push_back(static_cast<std::int32_t>(i));
-    edge_hexes_.assign(n, 0);
-    hex_joint_start_.assign(hexes.size() + 1, 0);
-    hex_joints_.clear();
-    for (std::size_t h = 0; h < hexes.size(); ++h) {
+    std::vector<std::vector<std::int32_t>> hexes_at(nn);  // hexahedra by node
+    for (std::size_t h = 0; h < hexes.size(); ++h)
       for (auto nd : hexes[h])
-        for (auto i : joints_at[static_cast<std::size_t>(nd)]) {
-          const auto& hx = hexes[h];
-          if (std::find(hx.begin(), hx.end(), ax_[static_cast<std::size_t>(i)]) == hx.end())
-            continue;
-          hex_joints_.push_back(i);
-          ++edge_hexes_[static_cast<std::size_t>(i)];
+        hexes_at[static_cast<std::size_t>(nd)].push_back(static_cast<std::int32_t>(h));
+    std::vector<std::int32_t> joint_hex(n, -1);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (auto nd : {a_[i], b_[i], ax_[i]})
+        if (nd < 0 || static_cast<std::size_t>(nd) >= nn)
+          throw InputError("", name_, "connection joins an invalid node");
+      for (auto h : hexes_at[static_cast<std::size_t>(b_[i])]) {
+        const auto& hx = hexes[static_cast<std::size_t>(h)];
+        if (std::find(hx.begin(), hx.end(), ax_[i]) != hx.end()) {
+          joint_hex[i] = h;
+          break;
         }
-      hex_joint_start_[h + 1] = static_cast<std::int32_t>(hex_joints_.size());
+      }
+      if (joint_hex[i] < 0)
+        throw InputError("", name_, "a connection's tow node and axis node share no hexahedron");
+    }
+    hex_joint_start_.assign(hexes.size() + 1, 0);
+    for (auto h : joint_hex) ++hex_joint_start_[static_cast<std::size_t>(h) + 1];
+    for (std::size_t h = 0; h < hexes.size(); ++h) hex_joint_start_[h + 1] += hex_joint_start_[h];
+    hex_joints_.assign(n, 0);
+    std::vector<std::int32_t> fill(hex_joint_start_.begin(), hex_joint_start_.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      hex_joints_[static_cast<std::size_t>(fill[static_cast<std::size_t>(joint_hex[i])]++)] =
+          static_cast<std::int32_t>(i);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& hx = hexes[static_cast<std::size_t>(joint_hex[i])];
+      const auto b = static_cast<std::size_t>(b_[i]), c = static_cast<std::size_t>(ax_[i]);
+      double edge[3], cen[3] = {0, 0, 0};
+      for (std::size_t k = 0; k < 3; ++k) edge[k] = x0[3 * c + k] - x0[3 * b + k];
+      for (auto nd : hx)
+        for (std::size_t k = 0; k < 3; ++k)
+          cen[k] += 0.125 * x0[3 * static_cast<std::size_t>(nd) + k];
+      double u0[3] = {0, 0, 0};
+      for (std::size_t I = 0; I < 8; ++I) {
+        const auto nd = static_cast<std::size_t>(hx[I]);
+        const double rel[3] = {x0[3 * nd] - cen[0], x0[3 * nd + 1] - cen[1],
+                               x0[3 * nd + 2] - cen[2]};
+        const double w = dot(rel, edge) > 0 ? 0.125 : -0.125;
+        hex8_[8 * i + I] = hx[I], w8_[8 * i + I] = w;
+        for (std::size_t k = 0; k < 3; ++k) u0[k] += w * x0[3 * nd + k];
+      }
+      const double len = std::sqrt(dot(u0, u0));
+      for (std::size_t k = 0; k < 3; ++k) t0_[3 * i + k] = u0[k] / len;
+      live_[i] = 1;
     }
     n_released_ = 0;
   }
   for (std::size_t i = 0; i < n; ++i) {
-    for (auto nd : {a_[i], b_[i], ax_[i]})
-      if (nd < 0 || static_cast<std::size_t>(nd) >= nn)
-        throw InputError("", name_, "connection joins an invalid node");
-    const auto a = static_cast<std::size_t>(a_[i]), b = static_cast<std::size_t>(b_[i]),
-               c = static_cast<std::size_t>(ax_[i]);
-    double len = 0;
-    for (std::size_t k = 0; k < 3; ++k) {
-      t0_[3 * i + k] = x0[3 * c + k] - x0[3 * b + k];
-      len += t0_[3 * i + k] * t0_[3 * i + k];
-      rest_[3 * i + k] = x0[3 * b + k] - x0[3 * a + k];
-    }
-    if (a == b || !(len > 0)) throw InputError("", name_, "connection joins an invalid node pair");
-    if (edge_hexes_[i] == 0)
-      throw InputError("", name_, "a connection's tow node and axis node share no hexahedron");
-    for (std::size_t k = 0; k < 3; ++k) t0_[3 * i + k] /= std::sqrt(len);
+    const auto a = static_cast<std::size_t>(a_[i]), b = static_cast<std::size_t>(b_[i]);
+    if (a == b || !std::isfinite(t0_[3 * i] + t0_[3 * i + 1] + t0_[3 * i + 2]))
+      throw InputError("", name_, "connection joins an invalid node pair");
+    for (std::size_t k = 0; k < 3; ++k) rest_[3 * i + k] = x0[3 * b + k] - x0[3 * a + k];
     const double m = std::min(setup.mass[3 * a], setup.mass[3 * b]);
     const double k_stable = s_.stiffness_scale * m / (setup.dt * setup.dt);
     k_[i] = s_.stiffness > 0 ? std::min(s_.stiffness, k_stable) : k_stable;
@@ -136,13 +162,17 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
   std::int64_t sliding = 0;
   fem::V3 total{};
   for (std::size_t i = 0; i < n; ++i) {
-    if (edge_hexes_[i] == 0) {  // released by erosion
+    if (!live_[i]) {  // released by erosion
       force_[i] = 0;
       continue;
     }
-    const std::size_t a = static_cast<std::size_t>(a_[i]), b = static_cast<std::size_t>(b_[i]),
-                      c_node = static_cast<std::size_t>(ax_[i]);
-    const TowTurn R = tow_turn(x, b, c_node, &t0_[3 * i]);
+    const std::size_t a = static_cast<std::size_t>(a_[i]), b = static_cast<std::size_t>(b_[i]);
+    const std::int32_t* hx = &hex8_[8 * i];
+    const double* w = &w8_[8 * i];
+    double u[3] = {0, 0, 0};
+    for (std::size_t I = 0; I < 8; ++I)
+      for (std::size_t k = 0; k < 3; ++k) u[k] += w[I] * x[3 * static_cast<std::size_t>(hx[I]) + k];
+    const TowTurn R = tow_turn(u, &t0_[3 * i]);
     double* rho = &rest_[3 * i];  // rest offset (with the slip) in the reference frame of the tow
     double r[3];
     R.apply(rho, r);
@@ -177,16 +207,15 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
       ++sliding;
     }
     force_[i] = kk * std::sqrt(dot(d, d));
-    // The forces of the energy k |d|^2 / 2 of the four... three positions: the turn of the rest
-    // offset with the tow axis (b to c) puts g on c and -g on b.
+    // The forces of the energy k |d|^2 / 2: the turn of the rest offset with the hexahedron's
+    // axis u puts w_I g on its nodes.
     const double kd[3] = {kk * d[0], kk * d[1], kk * d[2]};  // pulls a towards b and b towards a
     double g[3];
     R.adjoint(rho, kd, g);
-    for (std::size_t k = 0; k < 3; ++k) {
-      fc[3 * a + k] += kd[k];
-      fc[3 * b + k] -= kd[k] + g[k];
-      fc[3 * c_node + k] += g[k];
-    }
+    for (std::size_t k = 0; k < 3; ++k) fc[3 * a + k] += kd[k], fc[3 * b + k] -= kd[k];
+    for (std::size_t I = 0; I < 8; ++I)
+      for (std::size_t k = 0; k < 3; ++k)
+        fc[3 * static_cast<std::size_t>(hx[I]) + k] += w[I] * g[k];
     total += fem::V3{kd[0], kd[1], kd[2]};
   }
   dissipated_ += diss;
@@ -199,8 +228,8 @@ void StitchToTowConnection::erode(const std::vector<std::int32_t>& mesh_hexes) {
     const auto hh = static_cast<std::size_t>(h);
     if (hh + 1 >= hex_joint_start_.size()) continue;
     for (auto q = hex_joint_start_[hh]; q < hex_joint_start_[hh + 1]; ++q) {
-      auto& live = edge_hexes_[static_cast<std::size_t>(hex_joints_[static_cast<std::size_t>(q)])];
-      if (live > 0 && --live == 0) ++n_released_;
+      auto& live = live_[static_cast<std::size_t>(hex_joints_[static_cast<std::size_t>(q)])];
+      if (live) live = 0, ++n_released_;
     }
   }
 }

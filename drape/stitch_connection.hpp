@@ -10,6 +10,7 @@
 // node that gives the axis (docs/theory.md, "Stitch-to-tow connection"). Implemented as a contact
 // of the engine: its forces go to the contact forces, the spring energy and the slip work into the
 // contact energy, the slip work also into friction_dissipation.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -34,8 +35,8 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   double friction_dissipation() const override { return dissipated_; }
   std::int64_t active_contacts() const override { return n_sliding_; }
   std::vector<fem::ContactResultant> resultants() const override;
-  /// A joint whose tow edge (tow node to axis node) was in eroded hexahedra only is released:
-  /// its tow piece is gone, and its two nodes, no longer held together, would not give an axis.
+  /// A joint whose axis hexahedron (one holding its tow node and axis node) is eroded is
+  /// released: that piece of tow is gone and gives no axis.
   void erode(const std::vector<std::int32_t>& mesh_hexes) override;
   /// Joints released by erosion so far.
   std::size_t released() const { return n_released_; }
@@ -56,9 +57,12 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   std::vector<double> rest_;            // [3*n] rest offset b - a with the slip, set-up frame
   std::vector<double> k_;               // [n]
   std::vector<double> force_, slip_len_;
-  // Live hexahedra holding each joint's tow edge (0: released), and the joints whose tow edge each
-  // hexahedron holds (CSR by mesh hexahedron).
-  std::vector<std::int32_t> edge_hexes_;
+  // The hexahedron that gives each joint's tow axis: its nodes and weights (+-1/8 at its ends
+  // along the tow), whether the joint is live (0: released by erosion), and the joints of each
+  // hexahedron (CSR by mesh hexahedron).
+  std::vector<std::int32_t> hex8_;
+  std::vector<double> w8_;
+  std::vector<std::uint8_t> live_;
   std::vector<std::int32_t> hex_joint_start_, hex_joints_;
   std::size_t n_released_ = 0;
   double dissipated_ = 0;
