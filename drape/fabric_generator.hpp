@@ -5,7 +5,7 @@
 // zig-zag underlaps on the bottom face for tricot, legs through the thickness at the penetration
 // points, one bar per ply, with a stitch node on every ply boundary); each stitch node joined by a
 // connection to the nearest node of each tow beside its gap on that boundary, sliding along that
-// tow past a sliding force and elastic across it (on an interface:
+// tow past a sliding force and across it past a transverse force (on an interface:
 // the tows of both plies, which pins the plies to each other at the stitch points; on meshes with
 // elements longer than the tow pitch the search also reaches the next tows over).
 #include <array>
@@ -25,8 +25,8 @@ struct BlanketSpec {
 };
 
 /// A stitch node joined to a tow node (elastic, sliding along the tow past a sliding force and
-/// across it past a transverse force). The tow's axis at the tow node comes from its next node
-/// along the tow (same tow, same face).
+/// across it past a transverse force). The tow's axis there is that of a hexahedron holding the
+/// tow node and its next node along the tow (same tow, same face).
 struct StitchConnection {
   std::int32_t stitch_node = -1, tow_node = -1;
   std::int32_t tow_axis_node = -1;  // next node along the tow (fibre direction)

@@ -36,7 +36,7 @@ struct TowTurn {
     const double q = dot(a, v) / (1 + c);
     for (int k = 0; k < 3; ++k) out[k] = c * v[k] - axv[k] + q * a[k];
   }
-  /// g = (d(R v)/d x_c)^T h, with t = u/|u|, u = x_c - x_b (for x_b it is -g).
+  /// g = (d(R v)/d u)^T h, with t = u/|u| (u the tow axis vector the turn was made from).
   void adjoint(const double* v, const double* h, double* g) const {
     // h . d(R v) = dt . g_t, from dc = t0.dt and da = t0 x dt.
     const double vh = dot(v, h), t0v = dot(t0, v), t0h = dot(t0, h), av = dot(a, v), ah = dot(a, h);

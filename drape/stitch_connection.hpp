@@ -6,10 +6,10 @@
 // elastic up to a transverse force: the yarn lies in the gap between two tows and bears on their
 // sides, so a tow does not slip sideways past it at the pull-out force. The spring's rest offset
 // turns with the tow's axis (the smallest rotation from its set-up direction), so a turning tow
-// loads no joint; the forces are the gradient of the spring energy, including those on the tow
-// node that gives the axis (docs/theory.md, "Stitch-to-tow connection"). Implemented as a contact
-// of the engine: its forces go to the contact forces, the spring energy and the slip work into the
-// contact energy, the slip work also into friction_dissipation.
+// loads no joint; the forces are the gradient of the spring energy, including those on the nodes
+// of the tow hexahedron that gives the axis (docs/theory.md, "Stitch-to-tow connection").
+// Implemented as a contact of the engine: its forces go to the contact forces, the spring energy
+// and the slip work into the contact energy, the slip work also into friction_dissipation.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -52,7 +52,7 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   std::string name_;
   StitchConnectionSettings s_;
   std::vector<std::int32_t> a_, b_;     // stitch node, tow node
-  std::vector<std::int32_t> ax_;        // the tow's next node from b along it
+  std::vector<std::int32_t> ax_;  // the tow's next node from b along it (finds the hexahedron)
   std::vector<double> t0_;              // [3*n] tow axis at set-up (unit)
   std::vector<double> rest_;            // [3*n] rest offset b - a with the slip, set-up frame
   std::vector<double> k_;               // [n]
