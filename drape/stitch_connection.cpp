@@ -88,17 +88,16 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
   // The tow's axis at a joint is the axis of a hexahedron holding its tow edge (b, c): the mean
   // of its four edges along the tow, u = sum_I w_I x_I with w_I = +-1/8 at its two ends. The
   // turn of the offset with it then moves the hexahedron as a whole (no hourglass couple on
-  // one edge). Joints by hexahedron (CSR) for the release on erosion.
+  // one edge).
   const auto& hexes = setup.mesh->hexes;
   hex8_.assign(8 * n, 0);
   w8_.assign(8 * n, 0.0);
-  live_.assign(n, 0);
+  joint_hex_.assign(n, -1);
   {
     std::vector<std::vector<std::int32_t>> hexes_at(nn);  // hexahedra by node
     for (std::size_t h = 0; h < hexes.size(); ++h)
       for (auto nd : hexes[h])
         hexes_at[static_cast<std::size_t>(nd)].push_back(static_cast<std::int32_t>(h));
-    std::vector<std::int32_t> joint_hex(n, -1);
     for (std::size_t i = 0; i < n; ++i) {
       for (auto nd : {a_[i], b_[i], ax_[i]})
         if (nd < 0 || static_cast<std::size_t>(nd) >= nn)
@@ -106,23 +105,15 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
       for (auto h : hexes_at[static_cast<std::size_t>(b_[i])]) {
         const auto& hx = hexes[static_cast<std::size_t>(h)];
         if (std::find(hx.begin(), hx.end(), ax_[i]) != hx.end()) {
-          joint_hex[i] = h;
+          joint_hex_[i] = h;
           break;
         }
       }
-      if (joint_hex[i] < 0)
+      if (joint_hex_[i] < 0)
         throw InputError("", name_, "a connection's tow node and axis node share no hexahedron");
     }
-    hex_joint_start_.assign(hexes.size() + 1, 0);
-    for (auto h : joint_hex) ++hex_joint_start_[static_cast<std::size_t>(h) + 1];
-    for (std::size_t h = 0; h < hexes.size(); ++h) hex_joint_start_[h + 1] += hex_joint_start_[h];
-    hex_joints_.assign(n, 0);
-    std::vector<std::int32_t> fill(hex_joint_start_.begin(), hex_joint_start_.end() - 1);
-    for (std::size_t i = 0; i < n; ++i)
-      hex_joints_[static_cast<std::size_t>(fill[static_cast<std::size_t>(joint_hex[i])]++)] =
-          static_cast<std::int32_t>(i);
     for (std::size_t i = 0; i < n; ++i) {
-      const auto& hx = hexes[static_cast<std::size_t>(joint_hex[i])];
+      const auto& hx = hexes[static_cast<std::size_t>(joint_hex_[i])];
       const auto b = static_cast<std::size_t>(b_[i]), c = static_cast<std::size_t>(ax_[i]);
       double edge[3], cen[3] = {0, 0, 0};
       for (std::size_t k = 0; k < 3; ++k) edge[k] = x0[3 * c + k] - x0[3 * b + k];
@@ -140,7 +131,6 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
       }
       const double len = std::sqrt(dot(u0, u0));
       for (std::size_t k = 0; k < 3; ++k) t0_[3 * i + k] = u0[k] / len;
-      live_[i] = 1;
     }
     n_released_ = 0;
   }
@@ -162,7 +152,7 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
   std::int64_t sliding = 0;
   fem::V3 total{};
   for (std::size_t i = 0; i < n; ++i) {
-    if (!live_[i]) {  // released by erosion
+    if (joint_hex_[i] < 0) {  // released by erosion
       force_[i] = 0;
       continue;
     }
@@ -224,14 +214,10 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
 }
 
 void StitchToTowConnection::erode(const std::vector<std::int32_t>& mesh_hexes) {
-  for (auto h : mesh_hexes) {
-    const auto hh = static_cast<std::size_t>(h);
-    if (hh + 1 >= hex_joint_start_.size()) continue;
-    for (auto q = hex_joint_start_[hh]; q < hex_joint_start_[hh + 1]; ++q) {
-      auto& live = live_[static_cast<std::size_t>(hex_joints_[static_cast<std::size_t>(q)])];
-      if (live) live = 0, ++n_released_;
-    }
-  }
+  std::vector<std::int32_t> gone = mesh_hexes;  // erosion is rare: a sorted list to look up
+  std::sort(gone.begin(), gone.end());
+  for (auto& h : joint_hex_)
+    if (h >= 0 && std::binary_search(gone.begin(), gone.end(), h)) h = -1, ++n_released_;
 }
 
 std::vector<fem::ContactResultant> StitchToTowConnection::resultants() const { return {{name_, total_}}; }

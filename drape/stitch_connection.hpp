@@ -57,13 +57,11 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   std::vector<double> rest_;            // [3*n] rest offset b - a with the slip, set-up frame
   std::vector<double> k_;               // [n]
   std::vector<double> force_, slip_len_;
-  // The hexahedron that gives each joint's tow axis: its nodes and weights (+-1/8 at its ends
-  // along the tow), whether the joint is live (0: released by erosion), and the joints of each
-  // hexahedron (CSR by mesh hexahedron).
+  // The hexahedron that gives each joint's tow axis (mesh index, -1: the joint was released by
+  // erosion), its nodes and weights (+-1/8 at its ends along the tow).
+  std::vector<std::int32_t> joint_hex_;
   std::vector<std::int32_t> hex8_;
   std::vector<double> w8_;
-  std::vector<std::uint8_t> live_;
-  std::vector<std::int32_t> hex_joint_start_, hex_joints_;
   std::size_t n_released_ = 0;
   double dissipated_ = 0;
   std::int64_t n_sliding_ = 0;
