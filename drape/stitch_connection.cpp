@@ -36,22 +36,38 @@ struct TowTurn {
     const double q = dot(a, v) / (1 + c);
     for (int k = 0; k < 3; ++k) out[k] = c * v[k] - axv[k] + q * a[k];
   }
-  /// g = (d(R v)/d u)^T h, with t = u/|u| (u the tow axis vector the turn was made from).
-  void adjoint(const double* v, const double* h, double* g) const {
-    // h . d(R v) = dt . g_t, from dc = t0.dt and da = t0 x dt.
-    const double vh = dot(v, h), t0v = dot(t0, v), t0h = dot(t0, h), av = dot(a, v), ah = dot(a, h);
-    double v_t0[3], h_t0[3];
-    cross(v, t0, v_t0);
-    cross(h, t0, h_t0);
+  /// g = sum_j (d(R v_j)/d u)^T h_j, with t = u/|u| (u the tow axis vector the turn was made
+  /// from), given M = sum_j h_j (x) v_j (row-major): the expression is bilinear in (v, h).
+  void adjoint(const double* M, double* g) const {
+    // h . d(R v) = dt . g_t, from dc = t0.dt and da = t0 x dt:
+    // g_t = (v.h) t0 + (t0.v) h - (t0.h) v + ((a.h) v x t0 + (a.v) h x t0) / (1 + c)
+    //       - (a.v)(a.h) t0 / (1 + c)^2, summed over the joints.
+    double Mt0[3], MTt0[3], Ma[3], MTa[3];
+    for (int p = 0; p < 3; ++p) {
+      Mt0[p] = M[3 * p] * t0[0] + M[3 * p + 1] * t0[1] + M[3 * p + 2] * t0[2];
+      MTt0[p] = M[p] * t0[0] + M[3 + p] * t0[1] + M[6 + p] * t0[2];
+      Ma[p] = M[3 * p] * a[0] + M[3 * p + 1] * a[1] + M[3 * p + 2] * a[2];
+      MTa[p] = M[p] * a[0] + M[3 + p] * a[1] + M[6 + p] * a[2];
+    }
+    const double trM = M[0] + M[4] + M[8], aMa = dot(a, Ma);
+    double sum_x_t0[3];
+    const double s[3] = {MTa[0] + Ma[0], MTa[1] + Ma[1], MTa[2] + Ma[2]};
+    cross(s, t0, sum_x_t0);
     const double inv = 1 / (1 + c);
     double g_t[3];
     for (int k = 0; k < 3; ++k)
-      g_t[k] = vh * t0[k] + t0v * h[k] - t0h * v[k] + (ah * v_t0[k] + av * h_t0[k]) * inv -
-               av * ah * inv * inv * t0[k];
+      g_t[k] = trM * t0[k] + Mt0[k] - MTt0[k] + sum_x_t0[k] * inv - aMa * inv * inv * t0[k];
     const double gt = dot(g_t, t);
     for (int k = 0; k < 3; ++k) g[k] = (g_t[k] - gt * t[k]) / len_u;
   }
 };
+
+// A turn kept per hexahedron between the passes of a cycle: t, a, c, |u| (t0 is kept apart).
+constexpr std::size_t kTurnSize = 8;
+inline void store(const TowTurn& r, double* out) {
+  for (int k = 0; k < 3; ++k) out[k] = r.t[k], out[3 + k] = r.a[k];
+  out[6] = r.c, out[7] = r.len_u;
+}
 
 // The turn from t0 to the direction of u.
 inline TowTurn tow_turn(const double* u, const double* t0) {
@@ -61,6 +77,13 @@ inline TowTurn tow_turn(const double* u, const double* t0) {
   for (double& v : r.t) v /= r.len_u;
   r.c = dot(t0, r.t);
   cross(t0, r.t, r.a);
+  return r;
+}
+
+inline TowTurn load(const double* t0, const double* in) {
+  TowTurn r;
+  for (int k = 0; k < 3; ++k) r.t0[k] = t0[k], r.t[k] = in[k], r.a[k] = in[3 + k];
+  r.c = in[6], r.len_u = in[7];
   return r;
 }
 
@@ -80,7 +103,6 @@ StitchToTowConnection::StitchToTowConnection(std::string name, std::vector<Stitc
 void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
   const std::size_t n = a_.size(), nn = setup.mesh->n_nodes();
   rest_.assign(3 * n, 0.0);
-  t0_.assign(3 * n, 0.0);
   k_.assign(n, 0.0);
   force_.assign(n, 0.0);
   slip_len_.assign(n, 0.0);
@@ -88,32 +110,38 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
   // The tow's axis at a joint is the axis of a hexahedron holding its tow edge (b, c): the mean
   // of its four edges along the tow, u = sum_I w_I x_I with w_I = +-1/8 at its two ends. The
   // turn of the offset with it then moves the hexahedron as a whole (no hourglass couple on
-  // one edge).
+  // one edge). Joints sharing a hexahedron share its axis (the turn does not depend on which
+  // way along the tow the axis points).
   const auto& hexes = setup.mesh->hexes;
-  hex8_.assign(8 * n, 0);
-  w8_.assign(8 * n, 0.0);
-  joint_hex_.assign(n, -1);
-  {
-    std::vector<std::vector<std::int32_t>> hexes_at(nn);  // hexahedra by node
-    for (std::size_t h = 0; h < hexes.size(); ++h)
-      for (auto nd : hexes[h])
-        hexes_at[static_cast<std::size_t>(nd)].push_back(static_cast<std::int32_t>(h));
-    for (std::size_t i = 0; i < n; ++i) {
-      for (auto nd : {a_[i], b_[i], ax_[i]})
-        if (nd < 0 || static_cast<std::size_t>(nd) >= nn)
-          throw InputError("", name_, "connection joins an invalid node");
-      for (auto h : hexes_at[static_cast<std::size_t>(b_[i])]) {
-        const auto& hx = hexes[static_cast<std::size_t>(h)];
-        if (std::find(hx.begin(), hx.end(), ax_[i]) != hx.end()) {
-          joint_hex_[i] = h;
-          break;
-        }
+  joint_slot_.assign(n, -1);
+  slot_hex_.clear();
+  slot_nodes_.clear();
+  slot_w_.clear();
+  slot_t0_.clear();
+  std::vector<std::int32_t> slot_of_hex(hexes.size(), -1);
+  std::vector<std::vector<std::int32_t>> hexes_at(nn);  // hexahedra by node
+  for (std::size_t h = 0; h < hexes.size(); ++h)
+    for (auto nd : hexes[h])
+      hexes_at[static_cast<std::size_t>(nd)].push_back(static_cast<std::int32_t>(h));
+  for (std::size_t i = 0; i < n; ++i) {
+    for (auto nd : {a_[i], b_[i], ax_[i]})
+      if (nd < 0 || static_cast<std::size_t>(nd) >= nn)
+        throw InputError("", name_, "connection joins an invalid node");
+    std::int32_t hex = -1;
+    for (auto h : hexes_at[static_cast<std::size_t>(b_[i])]) {
+      const auto& hx = hexes[static_cast<std::size_t>(h)];
+      if (std::find(hx.begin(), hx.end(), ax_[i]) != hx.end()) {
+        hex = h;
+        break;
       }
-      if (joint_hex_[i] < 0)
-        throw InputError("", name_, "a connection's tow node and axis node share no hexahedron");
     }
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& hx = hexes[static_cast<std::size_t>(joint_hex_[i])];
+    if (hex < 0)
+      throw InputError("", name_, "a connection's tow node and axis node share no hexahedron");
+    auto& slot = slot_of_hex[static_cast<std::size_t>(hex)];
+    if (slot < 0) {
+      slot = static_cast<std::int32_t>(slot_hex_.size());
+      slot_hex_.push_back(hex);
+      const auto& hx = hexes[static_cast<std::size_t>(hex)];
       const auto b = static_cast<std::size_t>(b_[i]), c = static_cast<std::size_t>(ax_[i]);
       double edge[3], cen[3] = {0, 0, 0};
       for (std::size_t k = 0; k < 3; ++k) edge[k] = x0[3 * c + k] - x0[3 * b + k];
@@ -126,17 +154,23 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
         const double rel[3] = {x0[3 * nd] - cen[0], x0[3 * nd + 1] - cen[1],
                                x0[3 * nd + 2] - cen[2]};
         const double w = dot(rel, edge) > 0 ? 0.125 : -0.125;
-        hex8_[8 * i + I] = hx[I], w8_[8 * i + I] = w;
+        slot_nodes_.push_back(hx[I]);
+        slot_w_.push_back(w);
         for (std::size_t k = 0; k < 3; ++k) u0[k] += w * x0[3 * nd + k];
       }
       const double len = std::sqrt(dot(u0, u0));
-      for (std::size_t k = 0; k < 3; ++k) t0_[3 * i + k] = u0[k] / len;
+      for (std::size_t k = 0; k < 3; ++k) slot_t0_.push_back(u0[k] / len);
     }
-    n_released_ = 0;
+    joint_slot_[i] = slot;
   }
+  const std::size_t n_slots = slot_hex_.size();
+  slot_turn_.assign(kTurnSize * n_slots, 0.0);
+  slot_m_.assign(9 * n_slots, 0.0);
+  n_released_ = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const auto a = static_cast<std::size_t>(a_[i]), b = static_cast<std::size_t>(b_[i]);
-    if (a == b || !std::isfinite(t0_[3 * i] + t0_[3 * i + 1] + t0_[3 * i + 2]))
+    const double* t0 = &slot_t0_[3 * static_cast<std::size_t>(joint_slot_[i])];
+    if (a == b || !std::isfinite(t0[0] + t0[1] + t0[2]))
       throw InputError("", name_, "connection joins an invalid node pair");
     for (std::size_t k = 0; k < 3; ++k) rest_[3 * i + k] = x0[3 * b + k] - x0[3 * a + k];
     const double m = std::min(setup.mass[3 * a], setup.mass[3 * b]);
@@ -146,23 +180,30 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
 }
 
 void StitchToTowConnection::add_forces(const double* x, const double*, const double*, double, double* fc) {
-  const std::size_t n = a_.size();
+  const std::size_t n = a_.size(), n_slots = slot_hex_.size();
   const double Fs = s_.sliding_force, Ft = s_.transverse_force;
+  // Each hexahedron's axis and its turn from set-up, once.
+  for (std::size_t h = 0; h < n_slots; ++h) {
+    if (slot_hex_[h] < 0) continue;  // eroded
+    const std::int32_t* hx = &slot_nodes_[8 * h];
+    const double* w = &slot_w_[8 * h];
+    double u[3] = {0, 0, 0};
+    for (std::size_t I = 0; I < 8; ++I)
+      for (std::size_t k = 0; k < 3; ++k) u[k] += w[I] * x[3 * static_cast<std::size_t>(hx[I]) + k];
+    store(tow_turn(u, &slot_t0_[3 * h]), &slot_turn_[kTurnSize * h]);
+    std::fill_n(&slot_m_[9 * h], 9, 0.0);
+  }
   double diss = 0;
   std::int64_t sliding = 0;
   fem::V3 total{};
   for (std::size_t i = 0; i < n; ++i) {
-    if (joint_hex_[i] < 0) {  // released by erosion
+    if (joint_slot_[i] < 0) {  // released by erosion
       force_[i] = 0;
       continue;
     }
+    const auto h = static_cast<std::size_t>(joint_slot_[i]);
     const std::size_t a = static_cast<std::size_t>(a_[i]), b = static_cast<std::size_t>(b_[i]);
-    const std::int32_t* hx = &hex8_[8 * i];
-    const double* w = &w8_[8 * i];
-    double u[3] = {0, 0, 0};
-    for (std::size_t I = 0; I < 8; ++I)
-      for (std::size_t k = 0; k < 3; ++k) u[k] += w[I] * x[3 * static_cast<std::size_t>(hx[I]) + k];
-    const TowTurn R = tow_turn(u, &t0_[3 * i]);
+    const TowTurn R = load(&slot_t0_[3 * h], &slot_turn_[kTurnSize * h]);
     double* rho = &rest_[3 * i];  // rest offset (with the slip) in the reference frame of the tow
     double r[3];
     R.apply(rho, r);
@@ -197,16 +238,25 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
       ++sliding;
     }
     force_[i] = kk * std::sqrt(dot(d, d));
-    // The forces of the energy k |d|^2 / 2: the turn of the rest offset with the hexahedron's
-    // axis u puts w_I g on its nodes.
     const double kd[3] = {kk * d[0], kk * d[1], kk * d[2]};  // pulls a towards b and b towards a
-    double g[3];
-    R.adjoint(rho, kd, g);
     for (std::size_t k = 0; k < 3; ++k) fc[3 * a + k] += kd[k], fc[3 * b + k] -= kd[k];
+    double* M = &slot_m_[9 * h];
+    for (int p = 0; p < 3; ++p)
+      for (int q = 0; q < 3; ++q) M[3 * p + q] += kd[p] * rho[q];
+    total += fem::V3{kd[0], kd[1], kd[2]};
+  }
+  // The forces of the energy k |d|^2 / 2 through the turn of the rest offsets with each
+  // hexahedron's axis u: w_I g on its nodes, g summed over its joints.
+  for (std::size_t h = 0; h < n_slots; ++h) {
+    if (slot_hex_[h] < 0) continue;
+    const TowTurn R = load(&slot_t0_[3 * h], &slot_turn_[kTurnSize * h]);
+    double g[3];
+    R.adjoint(&slot_m_[9 * h], g);
+    const std::int32_t* hx = &slot_nodes_[8 * h];
+    const double* w = &slot_w_[8 * h];
     for (std::size_t I = 0; I < 8; ++I)
       for (std::size_t k = 0; k < 3; ++k)
         fc[3 * static_cast<std::size_t>(hx[I]) + k] += w[I] * g[k];
-    total += fem::V3{kd[0], kd[1], kd[2]};
   }
   dissipated_ += diss;
   n_sliding_ = sliding;
@@ -216,8 +266,10 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
 void StitchToTowConnection::erode(const std::vector<std::int32_t>& mesh_hexes) {
   std::vector<std::int32_t> gone = mesh_hexes;  // erosion is rare: a sorted list to look up
   std::sort(gone.begin(), gone.end());
-  for (auto& h : joint_hex_)
-    if (h >= 0 && std::binary_search(gone.begin(), gone.end(), h)) h = -1, ++n_released_;
+  for (auto& h : slot_hex_)
+    if (h >= 0 && std::binary_search(gone.begin(), gone.end(), h)) h = -1;
+  for (auto& slot : joint_slot_)
+    if (slot >= 0 && slot_hex_[static_cast<std::size_t>(slot)] < 0) slot = -1, ++n_released_;
 }
 
 std::vector<fem::ContactResultant> StitchToTowConnection::resultants() const { return {{name_, total_}}; }

@@ -47,21 +47,28 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   /// Spring stiffness in use (N/m): the requested one, capped by the stability limit.
   double stiffness(std::size_t i) const { return k_[i]; }
   std::size_t size() const { return a_.size(); }
+  /// Tow hexahedra that give the joints' axes (each counted once).
+  std::size_t axis_hexahedra() const { return slot_hex_.size(); }
 
  private:
   std::string name_;
   StitchConnectionSettings s_;
   std::vector<std::int32_t> a_, b_;     // stitch node, tow node
   std::vector<std::int32_t> ax_;  // the tow's next node from b along it (finds the hexahedron)
-  std::vector<double> t0_;              // [3*n] tow axis at set-up (unit)
-  std::vector<double> rest_;            // [3*n] rest offset b - a with the slip, set-up frame
-  std::vector<double> k_;               // [n]
+  std::vector<double> rest_;      // [3*n] rest offset b - a with the slip, set-up frame
+  std::vector<double> k_;         // [n]
   std::vector<double> force_, slip_len_;
-  // The hexahedron that gives each joint's tow axis (mesh index, -1: the joint was released by
-  // erosion), its nodes and weights (+-1/8 at its ends along the tow).
-  std::vector<std::int32_t> joint_hex_;
-  std::vector<std::int32_t> hex8_;
-  std::vector<double> w8_;
+  // The tow hexahedra that give the joints' axes, each once (about 8 joints share one on a coarse
+  // mesh): its axis is gathered and its forces scattered once per cycle. Per joint: its
+  // hexahedron's slot (-1: released by erosion).
+  std::vector<std::int32_t> joint_slot_;
+  std::vector<std::int32_t> slot_hex_;    // [n_slots] mesh hexahedron (-1: eroded)
+  std::vector<std::int32_t> slot_nodes_;  // [8*n_slots]
+  std::vector<double> slot_w_;            // [8*n_slots] +-1/8 at its ends along the tow
+  std::vector<double> slot_t0_;           // [3*n_slots] tow axis at set-up (unit)
+  // Per cycle, per slot: the turn of the axis (t, a = t0 x t, c = t0.t, |u|) and the sum of
+  // k d (x) rho over its joints, from which the forces on its nodes follow.
+  std::vector<double> slot_turn_, slot_m_;
   std::size_t n_released_ = 0;
   double dissipated_ = 0;
   std::int64_t n_sliding_ = 0;
