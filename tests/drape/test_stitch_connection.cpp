@@ -195,19 +195,25 @@ TEST(StitchConnection, ReleasedWhenItsAxisHexahedronIsEroded) {
   for (double c : f) EXPECT_EQ(c, 0.0);
 }
 
-// The joint is conservative: its forces on the stitch node, the tow node and the nodes of the
-// hexahedron that gives the tow's axis are minus the gradient of its energy k |d|^2 / 2 (central
-// differences, within 1e-6 of the largest force), and they sum to zero, for a stitch node and a tow
-// element moved and turned arbitrarily (elastic: limits far above the forces). (Their moment is not
-// zero: the offset turns by the smallest rotation from the tow's set-up axis, so a turn of the
-// whole joint about that axis loads it, as a twist of the tow under the stitch does.)
+// The joints are conservative: their forces on the stitch nodes, the tow nodes and the nodes of the
+// hexahedron that gives the tow's axis are minus the gradient of their energy sum k |d|^2 / 2
+// (central differences, within 1e-6 of the largest force), and they sum to zero, for stitch nodes
+// and a tow element moved and turned arbitrarily (elastic: limits far above the forces). Two
+// joints share the hexahedron, set up from its edge in opposite directions (tow node b with axis
+// node c, and c with b): they share its axis and its forces are summed before they are scattered.
+// (Their moment is not zero: the offset turns by the smallest rotation from the tow's set-up axis,
+// so a turn of the whole joint about that axis loads it, as a twist of the tow under the stitch
+// does.)
 TEST(StitchConnection, ForcesAreTheGradientOfTheSpringEnergy) {
-  const fem::Mesh mesh = one_joint_mesh();
+  fem::Mesh mesh = one_joint_mesh();
+  const auto a2 = static_cast<std::int32_t>(mesh.n_nodes());  // a second stitch node, over c
+  mesh.coords.insert(mesh.coords.end(), {-0.3e-3, 0.4e-3, 0.15e-3});
   const std::vector<double> mass(mesh.coords.size(), 1e-6);
   drape::StitchConnectionSettings s;
   s.sliding_force = 1e6, s.transverse_force = 1e6, s.stiffness = 1000;
-  drape::StitchToTowConnection conn("joint", {{0, 1, 2}}, s);
+  drape::StitchToTowConnection conn("joint", {{0, 1, 2}, {a2, 2, 1}}, s);
   conn.initialise({&mesh, nullptr, mesh.coords.data(), mass.data(), 1e-5});
+  ASSERT_EQ(conn.axis_hexahedra(), 1u);
   // A deformed state: every node moved by up to 0.3 mm, not a rigid motion.
   const std::size_t nd = mesh.coords.size();
   std::vector<double> x(nd);
@@ -216,7 +222,8 @@ TEST(StitchConnection, ForcesAreTheGradientOfTheSpringEnergy) {
   auto energy = [&](const std::vector<double>& at) {
     std::vector<double> f(nd, 0.0);
     conn.add_forces(at.data(), nullptr, nullptr, 1e-5, f.data());
-    return 0.5 * conn.force_magnitude(0) * conn.force_magnitude(0) / 1000;
+    return 0.5 * (std::pow(conn.force_magnitude(0), 2) + std::pow(conn.force_magnitude(1), 2)) /
+           1000;
   };
   std::vector<double> f(nd, 0.0);
   conn.add_forces(x.data(), nullptr, nullptr, 1e-5, f.data());
