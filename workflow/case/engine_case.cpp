@@ -557,10 +557,14 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       pp.bar_law = need(bar_laws, law, law == fe.law_I ? "stitch_law_I" : law == fe.law_Lambda ? "stitch_law_Lambda" : "stitch_law_legs");
       defined[static_cast<std::size_t>(p)] = 1;
     }
-    if (!fe.model.connections.empty())
+    int connection_contact = -1;
+    if (!fe.model.connections.empty()) {
+      connection_contact = static_cast<int>(ec.model.contacts.size());
       ec.model.contacts.push_back(std::make_unique<drape::StitchToTowConnection>(fe.name + "_stitch_tow", fe.model.connections, fe.connection));
-    ec.fabric_summaries.push_back({fe.name, fe.model.n_tows, fe.model.n_dropped_tows, fe.model.n_penetrations,
-                                   fe.model.connections.size(), fe.model.tow_thickness});
+    }
+    ec.fabric_summaries.push_back({fe.name, fe.model.n_tows, fe.model.n_dropped_tows,
+                                   fe.model.n_penetrations, fe.model.connections.size(),
+                                   fe.model.tow_thickness, connection_contact});
   }
   for (std::size_t p = 0; p < defined.size(); ++p)
     if (!defined[p]) root.fail("part", "part '" + mesh.part_names[p] + "' has no [[part]] entry (material)");

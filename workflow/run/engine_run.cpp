@@ -1,15 +1,16 @@
 #include "workflow/run/engine_run.hpp"
 
+#include <fmt/format.h>
+#include <spdlog/logger.h>
+
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
 
-#include <fmt/format.h>
-#include <spdlog/logger.h>
-
 #include "drape/stitch_calibration.hpp"
+#include "drape/stitch_connection.hpp"
 #include "fem/element_fields.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/result_writers.hpp"
@@ -191,6 +192,14 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
                        {"stitch_penetrations", f.penetrations}, {"stitch_connections", f.connections}};
   }
   if (!ec.fabric_summaries.empty()) summary["fabrics"] = fabrics;
+  // Stitch-to-tow joints released when the tow hexahedron that gives their axis erodes.
+  auto joints_released = [&](const FabricSummary& f) -> std::size_t {
+    if (f.connection_contact < 0) return 0;
+    const auto* c = dynamic_cast<const drape::StitchToTowConnection*>(
+        model.contacts[static_cast<std::size_t>(f.connection_contact)].get());
+    return c ? c->released() : 0;
+  };
+  std::vector<std::size_t> joints_released_logged(ec.fabric_summaries.size(), 0);
   const auto& st = solver.controlling_element();
   log->info("stable step {:.4g} s (safety factor {}), controlled by {} {}", solver.time_step(),
             model.time.safety_factor, st.is_bar ? "bar" : "hexahedron", st.element);
@@ -467,6 +476,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     summary["external_work_J"] = en.external_work;
     summary["hourglass_to_internal_ratio"] = en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
     summary["eroded_elements"] = solver.erosions().size();
+    for (const auto& f : ec.fabric_summaries)
+      summary["fabrics"][f.name]["stitch_connections_released"] = joints_released(f);
     summary["eroded_internal_energy_J"] = en.eroded_internal;
     for (const auto& t : model.tools) {
       summary[t.name + "_force_N"] = -dot(t.force, tool_axis(t));
@@ -571,6 +582,16 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
               "{:.6g}) m: {}",
               ev.element, model.mesh.part_names[static_cast<std::size_t>(ev.part)], ev.time,
               ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z, why);
+        }
+        for (std::size_t k = 0; k < ec.fabric_summaries.size(); ++k) {
+          const std::size_t n = joints_released(ec.fabric_summaries[k]);
+          if (n == joints_released_logged[k]) continue;
+          log->warn(
+              "fabric {}: {} stitch-to-tow connections released at t = {:.6g} s (their tow "
+              "hexahedron eroded), {} of {} in all",
+              ec.fabric_summaries[k].name, n - joints_released_logged[k], t, n,
+              ec.fabric_summaries[k].connections);
+          joints_released_logged[k] = n;
         }
         const double err = solver.energy().error();
         if (t > 0.05 * tc.end_time) max_error = std::max(max_error, err);  // skip the start, when little energy is in play
