@@ -1,10 +1,10 @@
-// Stitch-to-tow joint cost per joint and cycle: a +-45 blanket of the default fabric meshed as the
-// case files' resolutions mesh it (coarse: 1 element across a tow, 2 tow pitches long, so about
-// 8 joints share a tow hexahedron; default: 2 across, 1 pitch long), its stitch nodes joined to the
-// tows, every node moved by a smooth shear and rotation field so that every joint's tow axis has
-// turned and some joints slide. Counter ns_per_joint_cycle: wall time per (joint x cycle) of
-// add_forces.
-//   bench_stitch_joints                  a 100 x 100 mm blanket, coarse (0) and default (1)
+// Stitch-to-tow joint cost per joint and cycle: a +-45 blanket of the default fabric, meshed as the
+// bias-extension cases' CI mesh (0: 1 element across a tow, 2 tow pitches long, so about 8 joints
+// share a tow hexahedron) or as the generator's default (1: 2 across, 1 pitch long, the cases'
+// coarse resolution), its stitch nodes joined to the tows, every node moved by a smooth shear and
+// rotation field so that every joint's tow axis has turned and some joints slide. Counter
+// ns_per_joint_cycle: time per (joint x cycle) of add_forces.
+//   bench_stitch_joints                  a 100 x 100 mm blanket, CI mesh (0) and default (1)
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -21,7 +21,7 @@ void BM_StitchJoints(benchmark::State& state) {
   const double size = 1e-3 * static_cast<double>(state.range(0));
   fem::Mesh mesh;
   drape::FabricSpec fabric;
-  if (state.range(1) == 0) {  // workflow's "coarse"
+  if (state.range(1) == 0) {  // the bias cases' CI mesh
     fabric.elements_across_tow = 1;
     fabric.element_length = 2 * fabric.tow_pitch();
   }

@@ -58,8 +58,8 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   std::vector<double> rest_;      // [3*n] rest offset b - a with the slip, set-up frame
   std::vector<double> k_;         // [n]
   std::vector<double> force_, slip_len_;
-  // The tow hexahedra that give the joints' axes, each once (about 8 joints share one on a coarse
-  // mesh): its axis is gathered and its forces scattered once per cycle. Per joint: its
+  // The tow hexahedra that give the joints' axes, each once (about 8 joints share one on the bias
+  // cases' CI mesh): its axis is gathered and its forces scattered once per cycle. Per joint: its
   // hexahedron's slot (-1: released by erosion).
   std::vector<std::int32_t> joint_slot_;
   std::vector<std::int32_t> slot_hex_;    // [n_slots] mesh hexahedron (-1: eroded)
