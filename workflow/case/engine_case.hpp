@@ -111,8 +111,8 @@ struct FabricSummary {
   std::string name;
   std::size_t tows = 0, dropped_tows = 0, penetrations = 0, connections = 0;
   double tow_thickness = 0;
-  int connection_contact =
-      -1;  // index of its stitch-to-tow connection in model.contacts (-1: none)
+  // Index of its stitch-to-tow connection in model.contacts (-1: none).
+  int connection_contact = -1;
 };
 
 struct EngineCase {
