@@ -192,12 +192,17 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
                        {"stitch_penetrations", f.penetrations}, {"stitch_connections", f.connections}};
   }
   if (!ec.fabric_summaries.empty()) summary["fabrics"] = fabrics;
-  // Stitch-to-tow joints released when the tow hexahedron that gives their axis erodes.
-  auto joints_released = [&](const FabricSummary& f) -> std::size_t {
-    if (f.connection_contact < 0) return 0;
-    const auto* c = dynamic_cast<const drape::StitchToTowConnection*>(
-        model.contacts[static_cast<std::size_t>(f.connection_contact)].get());
-    return c ? c->released() : 0;
+  // Stitch-to-tow joints released when the tow hexahedron that gives their axis erodes (per
+  // fabric; null where it has none).
+  std::vector<const drape::StitchToTowConnection*> fabric_joints;
+  for (const auto& f : ec.fabric_summaries)
+    fabric_joints.push_back(
+        f.connection_contact < 0
+            ? nullptr
+            : dynamic_cast<const drape::StitchToTowConnection*>(
+                  model.contacts[static_cast<std::size_t>(f.connection_contact)].get()));
+  auto joints_released = [&](std::size_t k) -> std::size_t {
+    return fabric_joints[k] ? fabric_joints[k]->released() : 0;
   };
   std::vector<std::size_t> joints_released_logged(ec.fabric_summaries.size(), 0);
   const auto& st = solver.controlling_element();
@@ -476,8 +481,9 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     summary["external_work_J"] = en.external_work;
     summary["hourglass_to_internal_ratio"] = en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
     summary["eroded_elements"] = solver.erosions().size();
-    for (const auto& f : ec.fabric_summaries)
-      summary["fabrics"][f.name]["stitch_connections_released"] = joints_released(f);
+    for (std::size_t k = 0; k < ec.fabric_summaries.size(); ++k)
+      summary["fabrics"][ec.fabric_summaries[k].name]["stitch_connections_released"] =
+          joints_released(k);
     summary["eroded_internal_energy_J"] = en.eroded_internal;
     for (const auto& t : model.tools) {
       summary[t.name + "_force_N"] = -dot(t.force, tool_axis(t));
@@ -569,6 +575,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
       }
       solver.step([&] {
         const double t = solver.time();
+        const std::size_t erosions_before = erosions_logged;
         for (; erosions_logged < solver.erosions().size(); ++erosions_logged) {
           const auto& ev = solver.erosions()[erosions_logged];
           const std::string why = ev.cause == fem::ErosionEvent::Cause::InvertedCorner
@@ -583,16 +590,17 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
               ev.element, model.mesh.part_names[static_cast<std::size_t>(ev.part)], ev.time,
               ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z, why);
         }
-        for (std::size_t k = 0; k < ec.fabric_summaries.size(); ++k) {
-          const std::size_t n = joints_released(ec.fabric_summaries[k]);
-          if (n == joints_released_logged[k]) continue;
-          log->warn(
-              "fabric {}: {} stitch-to-tow connections released at t = {:.6g} s (their tow "
-              "hexahedron eroded), {} of {} in all",
-              ec.fabric_summaries[k].name, n - joints_released_logged[k], t, n,
-              ec.fabric_summaries[k].connections);
-          joints_released_logged[k] = n;
-        }
+        if (erosions_logged > erosions_before)  // joints go only with an eroded hexahedron
+          for (std::size_t k = 0; k < fabric_joints.size(); ++k) {
+            const std::size_t n = joints_released(k);
+            if (n == joints_released_logged[k]) continue;
+            log->warn(
+                "fabric {}: {} stitch-to-tow connections released at t = {:.6g} s (their tow "
+                "hexahedron eroded), {} of {} in all",
+                ec.fabric_summaries[k].name, n - joints_released_logged[k], t, n,
+                ec.fabric_summaries[k].connections);
+            joints_released_logged[k] = n;
+          }
         const double err = solver.energy().error();
         if (t > 0.05 * tc.end_time) max_error = std::max(max_error, err);  // skip the start, when little energy is in play
         if (t >= next_history) {
