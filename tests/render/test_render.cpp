@@ -365,3 +365,37 @@ TEST(Render, BadInputThrows)
   EXPECT_THROW(plot_curves_png(plot, output_dir() / "never.png"), std::runtime_error);
   EXPECT_FALSE(fs::exists(output_dir() / "never.png"));
 }
+
+// Eroded hexahedra are left out of a figure: a 3 x 2 slab (temperature i + 0.5 per cell) with a
+// bar, less its two middle cells, keeps 4 hexahedra and their values (0.5, 2.5, 0.5, 2.5) in
+// order, the bar and its value after them, every point and the point field; the slab less those
+// cells renders (a gap down the middle).
+TEST(Render, WithoutHexesDropsTheCellsAndTheirValues) {
+  RenderMesh mesh = slab(3, 2);
+  mesh.bar2 = {0, 3};
+  MeshField stress{"stress", "Pa", true, 2, {}};
+  for (int c = 0; c < 6; ++c) {
+    stress.values.insert(stress.values.end(), {double(c), 10.0 * c});
+  }
+  stress.values.insert(stress.values.end(), {-1.0, -2.0});  // the bar
+  mesh.fields[0].values.push_back(7.0);                     // temperature of the bar
+  mesh.fields.push_back(stress);
+  const std::vector<char> drop{0, 1, 0, 0, 1, 0};
+  const RenderMesh kept = without_hexes(mesh, drop);
+  ASSERT_EQ(kept.hex8.size(), 4u * 8u);
+  EXPECT_EQ(std::vector<std::int64_t>(kept.hex8.begin() + 8, kept.hex8.begin() + 16),
+            std::vector<std::int64_t>(mesh.hex8.begin() + 16, mesh.hex8.begin() + 24));
+  EXPECT_EQ(kept.points, mesh.points);
+  EXPECT_EQ(kept.bar2, mesh.bar2);
+  ASSERT_EQ(kept.fields.size(), 3u);
+  EXPECT_EQ(kept.fields[0].values, (std::vector<double>{0.5, 2.5, 0.5, 2.5, 7.0}));
+  EXPECT_EQ(kept.fields[1].values, mesh.fields[1].values);  // on the points
+  EXPECT_EQ(kept.fields[2].values, (std::vector<double>{0, 0, 2, 20, 3, 30, 5, 50, -1, -2}));
+  EXPECT_THROW(without_hexes(mesh, {0, 1}), std::invalid_argument);
+
+  MeshFigure figure;
+  figure.field = "temperature";
+  const fs::path png = output_dir() / "slab_without_middle.png";
+  EXPECT_NO_THROW(render_mesh_png(kept, figure, png));
+  EXPECT_TRUE(fs::exists(png));
+}

@@ -1,9 +1,9 @@
 #include "workflow/figures/figures.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-
 #include <nlohmann/json.hpp>
 
 #include "fem/io/result_reader.hpp"
@@ -153,6 +153,15 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
         }
         rm.fields.push_back({f.name, unit_of(f.name), f.on_cells, f.n_components, f.values});
       }
+      // Eroded hexahedra are not drawn: nothing holds their lone nodes, which fly off.
+      const std::size_t n_hex = m.hex8.size() / 8;
+      std::vector<char> eroded(n_hex, 0);
+      for (const auto& f : frame.fields)
+        if (f.name == "eroded" && f.on_cells && f.n_components == 1)
+          for (std::size_t e = 0; e < n_hex && e < f.values.size(); ++e)
+            eroded[e] = f.values[e] != 0;
+      if (std::find(eroded.begin(), eroded.end(), 1) != eroded.end())
+        rm = render::without_hexes(rm, eroded);
       for (const auto& p : spec.at("pictures")) {
         const std::string name = p.at("name");
         try {
@@ -177,7 +186,7 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
               }
             };
             for (std::size_t e = 0; e < m.hex_part.size(); ++e)
-              if (m.hex_part[e] == part)
+              if (m.hex_part[e] == part && !eroded[e])
                 for (int I = 0; I < 8; ++I) grow(m.hex8[8 * e + static_cast<std::size_t>(I)]);
             for (std::size_t e = 0; e < m.bar_part.size(); ++e)
               if (m.bar_part[e] == part) grow(m.bar2[2 * e]), grow(m.bar2[2 * e + 1]);

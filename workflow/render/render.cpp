@@ -564,6 +564,34 @@ BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8)
 
 } // namespace
 
+RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop) {
+  const std::size_t n_hex = mesh.hex8.size() / 8;
+  if (drop.size() != n_hex)
+    throw std::invalid_argument("without_hexes: " + std::to_string(drop.size()) + " flags for " +
+                                std::to_string(n_hex) + " hexahedra");
+  RenderMesh out;
+  out.points = mesh.points;
+  out.bar2 = mesh.bar2;
+  for (std::size_t e = 0; e < n_hex; ++e)
+    if (!drop[e])
+      out.hex8.insert(out.hex8.end(), mesh.hex8.begin() + 8 * e, mesh.hex8.begin() + 8 * e + 8);
+  for (const auto& f : mesh.fields) {
+    if (!f.on_cells) {
+      out.fields.push_back(f);
+      continue;
+    }
+    MeshField g{f.name, f.unit, true, f.n_components, {}};
+    const auto nc = static_cast<std::size_t>(f.n_components);
+    for (std::size_t e = 0; e < n_hex && nc * (e + 1) <= f.values.size(); ++e)
+      if (!drop[e])
+        g.values.insert(g.values.end(), f.values.begin() + nc * e, f.values.begin() + nc * (e + 1));
+    if (f.values.size() > nc * n_hex)  // the bars' values
+      g.values.insert(g.values.end(), f.values.begin() + nc * n_hex, f.values.end());
+    out.fields.push_back(std::move(g));
+  }
+  return out;
+}
+
 void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
                      const std::filesystem::path& png)
 {

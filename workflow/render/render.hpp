@@ -53,6 +53,12 @@ struct MeshFigure {
   std::optional<std::array<double, 6>> focus_bounds;
 };
 
+// The mesh without the hexahedra marked in `drop` (one flag per hexahedron, e.g. eroded ones, whose
+// nodes may have flown off once nothing held them): their cell-field values go with them; the
+// points, the bars and the point fields stay. Throws std::invalid_argument if `drop` does not hold
+// one flag per hexahedron.
+RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop);
+
 // Surface of the hexahedra plus the bars as lines, coloured by the field (blue = low, red = high),
 // a scalar bar titled "name [unit]", the figure title, white background.
 void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
