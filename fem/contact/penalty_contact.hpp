@@ -119,24 +119,31 @@ class PenaltyContact final : public ContactAlgorithm {
 
   // State and work arrays, sized in initialise(), reused every cycle.
   std::vector<double> x_sorted_;           // [n_snode][3] positions at the last sort
-  std::vector<double> tangential_;         // [n_facet][3] elastic friction force per node facet, N
-  std::vector<std::int32_t> facet_start_;  // [n_snode + 1] first facet of each surface node
-  std::vector<double> tangential_old_;     // the two above before the last sort (carried over)
+  /// Contact state of a node facet carried from cycle to cycle (one record, not four arrays:
+  /// the force pass reads and writes it for every facet).
+  struct FacetState {
+    double tang[3] = {0, 0, 0};  // elastic friction force, N
+    double offset = 0;           // penetration offset of the contact (no force jump), m
+    double elastic = 0;          // penetration past the offset in the last cycle, m
+    std::int32_t last = -1;      // contact segment in the last cycle, -1: none
+  };
+  std::vector<FacetState> facet_state_;      // [n_facet]
+  std::vector<FacetState> facet_state_old_;  // before the last sort (carried over)
+  std::vector<std::int32_t> facet_start_;    // [n_snode + 1] first facet of each surface node
   std::vector<std::int32_t> facet_start_old_;
-  std::vector<double> offset_;   // [n_facet] penetration offset of the contact (no force jump), m
-  std::vector<double> elastic_;  // [n_facet] penetration past the offset in the last cycle, m
-  std::vector<double> offset_old_, elastic_old_;  // before the last sort (carried over)
-  std::vector<std::int32_t> last_seg_;      // [n_facet] contact segment of each node facet in the
-  std::vector<std::int32_t> last_seg_old_;  // last cycle, -1: none (and before the last sort)
   std::vector<double> node_mass_;          // [n_nodes] lumped nodal masses (fixed after set-up), kg
   std::vector<std::int32_t> cand_start_;   // [n_snode + 1] CSR into cand_seg_ (at the sort)
   std::vector<std::int32_t> cand_seg_;     // candidate segments, node by node
   std::vector<std::uint8_t> cand_facet_;   // facet of the node each candidate faces
   // The candidates segment by segment (what the cycle reads): segments with candidates in
-  // increasing order, CSR into the surface node and the global facet index of each candidate.
-  // ucand_mnode_ holds the mesh node of each candidate (what the projection reads), ucand_node_
-  // its surface node (only for the closest-feature test).
-  std::vector<std::int32_t> used_seg_, used_cand_start_, ucand_node_, ucand_mnode_, ucand_facet_;
+  // increasing order, CSR into ucand_ (mesh node and facet of each candidate, one record) and
+  // ucand_node_ (its surface node, only for the closest-feature test).
+  struct Candidate {
+    std::int32_t mesh_node;  // what the projection reads
+    std::int32_t facet;      // global index of the node facet it faces
+  };
+  std::vector<std::int32_t> used_seg_, used_cand_start_, ucand_node_;
+  std::vector<Candidate> ucand_;
   std::vector<std::int32_t> seg_count_;  // [n_seg + 1] work array of the counting sort
   /// Best hit of a node facet in the current cycle: one record of 32 bytes per facet (was three
   /// arrays), written by the narrow phase and read, then reset, by the force pass.
