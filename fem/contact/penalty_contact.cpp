@@ -275,6 +275,10 @@ void PenaltyContact::sort_segments(const double* x) {
             unit[j][k];
   }
 
+  force_node_.resize(n_node);
+  for (std::size_t e = 0; e < n_node; ++e)
+    force_node_[e] = {surf_.node[e], surf_.node_group[e], facet_start_[e], n_facets_[e]};
+
   // Friction state and last contact segment carried over facet by facet.
   facet_state_.assign(static_cast<std::size_t>(facet_start_[n_node]), FacetState{});
   if (!facet_state_old_.empty()) {
@@ -397,10 +401,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   const double thick = cfg_.thickness, lim = 1.0 + 2.0 * cfg_.edge_tolerance;
   const double kscale = cfg_.penalty_scale * inv_dt0_sq_;
   const double damp = 2.0 * cfg_.damping * std::sqrt(kscale);  // 2 zeta sqrt(k m_eff) / m_eff
-  const std::int32_t* node = surf_.node.data();
-  const std::int32_t* group = surf_.node_group.data();
   const std::uint8_t* n_facets = n_facets_.data();
-  const std::int32_t* facet_start = facet_start_.data();
   const double* m_node = node_mass_.data();
   const std::int32_t* sn = surf_.seg_nodes.data();
   const std::int32_t* sg = surf_.seg_group.data();
@@ -481,13 +482,15 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     }
     B.n = 0;
   };
+  const ForceNode* fnode = force_node_.data();
   for (std::size_t e = 0; e < n_node; ++e) {
-    const int nf = n_facets[e];
-    const auto f0 = static_cast<std::size_t>(facet_start[e]);
-    const auto i = static_cast<std::size_t>(node[e]);
+    const ForceNode R = fnode[e];
+    const int nf = R.n_facets;
+    const auto f0 = static_cast<std::size_t>(R.facet_start);
+    const auto i = static_cast<std::size_t>(R.mesh_node);
     const double m_s = m_node[i];
     const double vsx = v[3 * i], vsy = v[3 * i + 1], vsz = v[3 * i + 2];
-    const std::size_t row = static_cast<std::size_t>(group[e]) * ng;
+    const std::size_t row = static_cast<std::size_t>(R.group) * ng;
     for (std::size_t fi = f0; fi < f0 + static_cast<std::size_t>(nf); ++fi) {
       FacetState& S = state[fi];
       double* ft = S.tang;

@@ -127,6 +127,11 @@ class PenaltyContact final : public ContactAlgorithm {
     double elastic = 0;          // penetration past the offset in the last cycle, m
     std::int32_t last = -1;      // contact segment in the last cycle, -1: none
   };
+  /// What the force pass reads of each surface node, in one record (made at the sort).
+  struct ForceNode {
+    std::int32_t mesh_node, group, facet_start, n_facets;
+  };
+  std::vector<ForceNode> force_node_;        // [n_snode]
   std::vector<FacetState> facet_state_;      // [n_facet]
   std::vector<FacetState> facet_state_old_;  // before the last sort (carried over)
   std::vector<std::int32_t> facet_start_;    // [n_snode + 1] first facet of each surface node
