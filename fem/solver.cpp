@@ -1,8 +1,10 @@
 #include "fem/solver.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "fem/errors.hpp"
 
@@ -33,26 +35,43 @@ struct NodeUpdateSums {
 
 // v^{n+1/2} of every DOF as if free, branch-free so that it vectorises; with kMoveX the positions
 // move on to x^{n+1} in the same pass (one sweep over the nodal arrays when no callback needs x^n).
-template <bool kMoveX>
-NodeUpdateSums free_node_update(std::size_t nd, double alpha, double dt_mid, double dt_new, const double* inv_m,
-                                const double* mm, const double* fi, const double* fe, const double* fcon,
-                                double* vel, double* fdamp, double* x) {
+// The pass is bound by memory traffic, so the arrays of absent force kinds (kExt, kContact,
+// kDamp false) are neither read nor written: the sums of those kinds stay zero.
+template <bool kMoveX, bool kExt, bool kContact, bool kDamp>
+NodeUpdateSums free_node_update(std::size_t nd, double alpha, double dt_mid, double dt_new,
+                                const double* inv_m, const double* mm, const double* fi,
+                                const double* fe, const double* fcon, double* vel, double* fdamp,
+                                double* x) {
   double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
 #pragma omp simd reduction(+ : ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke)
   for (std::size_t d = 0; d < nd; ++d) {
     const double vo = vel[d], m = mm[d];
-    const double fd = -alpha * m * vo;
-    const double vn = vo + dt_mid * (fi[d] + fe[d] + fcon[d] + fd) * inv_m[d];
+    double f = fi[d];
+    if constexpr (kExt) f += fe[d];
+    if constexpr (kContact) f += fcon[d];
+    double fd = 0;
+    if constexpr (kDamp) fd = -alpha * m * vo, f += fd;
+    const double vn = vo + dt_mid * f * inv_m[d];
     vel[d] = vn;
-    fdamp[d] = fd;
     if constexpr (kMoveX) x[d] += dt_new * vn;
-    ext_old += fe[d] * vo, ext_new += fe[d] * vn;
-    damp_old += fd * vo, damp_new += fd * vn;
-    con_old += fcon[d] * vo, con_new += fcon[d] * vn;
+    if constexpr (kExt) ext_old += fe[d] * vo, ext_new += fe[d] * vn;
+    if constexpr (kDamp) fdamp[d] = fd, damp_old += fd * vo, damp_new += fd * vn;
+    if constexpr (kContact) con_old += fcon[d] * vo, con_new += fcon[d] * vn;
     ke += m * vo * vn;
   }
   return {ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke};
 }
+
+using NodeUpdate = NodeUpdateSums (*)(std::size_t, double, double, double, const double*,
+                                      const double*, const double*, const double*, const double*,
+                                      double*, double*, double*);
+// free_node_update for each combination, indexed by kMoveX * 8 + kExt * 4 + kContact * 2 + kDamp.
+template <std::size_t... I>
+constexpr std::array<NodeUpdate, sizeof...(I)> node_update_table(std::index_sequence<I...>) {
+  return {&free_node_update<(I & 8) != 0, (I & 4) != 0, (I & 2) != 0, (I & 1) != 0>...};
+}
+constexpr auto kNodeUpdates = node_update_table(std::make_index_sequence<16>{});
+
 // Velocity of the frame's material point (xi, eta) at time t (d/dt of corner + xi u1 + eta u2).
 V3 frame_point_velocity(const PictureFrame& pf, double t, double xi, double eta) {
   const double g = picture_frame_angle(pf, t), gd = 0.5 * picture_frame_rate(pf, t);
@@ -556,9 +575,13 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   // without branches (it vectorises), then those DOFs are corrected.
   for (std::size_t k = 0; k < constrained_.size(); ++k) constrained_vo_[k] = vel[constrained_[k]];
   const double dtp = dt_prev_;
+  // Without damping this cycle f_damp is left alone by the pass, so it is cleared once here.
+  if (alpha == 0 && !f_damp_zero_) std::fill(fdamp, fdamp + nd, 0.0);
+  f_damp_zero_ = alpha == 0;
+  const std::size_t kind =
+      (xfused ? 8 : 0) + (has_ext ? 4 : 0) + (has_contact ? 2 : 0) + (alpha != 0 ? 1 : 0);
   auto [ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke] =
-      xfused ? free_node_update<true>(nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused)
-             : free_node_update<false>(nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, nullptr);
+      kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused);
   // Works over the increments du_old = dt_prev v^{n-1/2}, du_new = dt_new v^{n+1/2}; kinetic energy
   // in product form: with the trapezoidal works, 1/2 v^{n-1/2} M v^{n+1/2} makes the discrete
   // energy balance of central differences exact for conservative forces.

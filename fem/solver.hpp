@@ -125,6 +125,7 @@ class ExplicitSolver {
   std::vector<std::size_t> constrained_;  // DOFs with a fixed or prescribed velocity
   std::vector<double> constrained_vo_;    // their v^{n-1/2} during a cycle
   std::vector<double> zero_;              // [3*n] zeros for force arrays a model does not use
+  bool f_damp_zero_ = false;              // f_damp holds zeros (no damping since it was cleared)
   std::vector<double> inv_mass_;      // [3*n] 1 / lumped mass
   std::vector<double> gravity_mass_;  // [3*n] physical nodal masses (no mass scaling)  // prescribed velocities at t^{n+1/2}, one per set
   std::int64_t cycle_ = 0;
