@@ -32,6 +32,21 @@ void require_output_folder(const std::filesystem::path& dir) {
     throw ncfsim::InputError(dir.string(), "", "not a folder (give the output folder of a run)");
 }
 
+// Until the domain decomposition lands the engine runs on one MPI rank: started by mpirun on
+// more, every rank would run the whole model and write the same files. Returns the exit code
+// (0: one rank); rank 0 says why.
+int refuse_many_ranks() {
+  const int n = ncfsim::fem::PetscSession::size();
+  if (n <= 1) return 0;
+  if (ncfsim::fem::PetscSession::rank() == 0)
+    std::fprintf(stderr,
+                 "ncfsim: bad input: started on %d MPI ranks, but the domain decomposition is not "
+                 "implemented yet (each rank would run the whole model and write the same files): "
+                 "start ncfsim without mpirun/mpiexec (one rank)\n",
+                 n);
+  return wf::kBadInput;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -115,6 +130,7 @@ int main(int argc, char** argv) {
       auto ec = wf::load_engine_case(case_file, overrides);
       // Building the solver checks what only the assembled model can show (massless nodes, steps).
       ncfsim::fem::PetscSession petsc;
+      if (const int code = refuse_many_ranks()) return code;
       ncfsim::fem::ExplicitSolver probe(ec.model);
       std::printf("%s: OK (case '%s', %zu nodes, %zu hexahedra, %zu bars, stable step %.4g s, about %.3g cycles)\n",
                   case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(), probe.n_hexes(), probe.n_bars(),
@@ -124,6 +140,7 @@ int main(int argc, char** argv) {
     if (*run) {
       auto ec = wf::load_engine_case(case_file, overrides);
       ncfsim::fem::PetscSession petsc;
+      if (const int code = refuse_many_ranks()) return code;
       wf::RunOptions o;
       o.out_dir = out_dir;
       o.verbosity = verbosity;
@@ -141,6 +158,7 @@ int main(int argc, char** argv) {
     }
     if (*cal_bend) {
       ncfsim::fem::PetscSession petsc;
+      if (const int code = refuse_many_ranks()) return code;
       const auto r = wf::calibrate_tow_bending(tb);
       std::printf("E11f = %.6g Pa gives a bending length of %.6g m (target %.6g m) after %d runs%s; see %s\n", r.E11f,
                   r.bending_length, tb.target_bending_length, r.runs, r.converged ? "" : " (NOT converged)",

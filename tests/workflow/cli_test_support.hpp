@@ -32,21 +32,23 @@ inline std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-/// Starts ncfsim with args, stdout and stderr into `log`; returns the child's pid.
-inline pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+/// Starts ncfsim with args, stdout and stderr into `log`; returns the child's pid. With a
+/// launcher (e.g. {mpiexec, -n, 2}) the child is the launcher, given ncfsim and args.
+inline pid_t spawn(const std::vector<std::string>& args, const fs::path& log,
+                   const std::vector<std::string>& launcher = {}) {
   const pid_t pid = fork();
   if (pid == 0) {
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(fd, 1);
     dup2(fd, 2);
     ::unsetenv("DISPLAY");
+    std::vector<std::string> all = launcher;
+    all.push_back(kExe.string());
+    all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
-    std::string exe = kExe.string();
-    argv.push_back(exe.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
+    for (auto& a : all) argv.push_back(a.data());
     argv.push_back(nullptr);
-    execv(exe.c_str(), argv.data());
+    execv(all.front().c_str(), argv.data());
     _exit(127);
   }
   return pid;
@@ -59,11 +61,12 @@ inline int wait_code(pid_t pid) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-/// Runs ncfsim with args to the end.
-inline Result run_cli(const std::vector<std::string>& args) {
+/// Runs ncfsim with args to the end (through `launcher` when one is given).
+inline Result run_cli(const std::vector<std::string>& args,
+                      const std::vector<std::string>& launcher = {}) {
   const fs::path log = fs::temp_directory_path() / ("ncfsim_cli_" + std::to_string(getpid()) + ".log");
   Result r;
-  r.code = wait_code(spawn(args, log));
+  r.code = wait_code(spawn(args, log, launcher));
   r.output = slurp(log);
   fs::remove(log);
   return r;
