@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -59,6 +60,20 @@ inline int wait_code(pid_t pid) {
   int status = 0;
   waitpid(pid, &status, 0);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+/// Exit code of the child, or -1 when it was still running after `seconds` (it is then sent
+/// SIGTERM and reaped).
+inline int wait_code_within(pid_t pid, double seconds) {
+  for (double waited = 0; waited < seconds; waited += 0.05) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid)
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    usleep(50000);
+  }
+  kill(pid, SIGTERM);
+  wait_code(pid);
+  return -1;
 }
 
 /// Runs ncfsim with args to the end (through `launcher` when one is given).
