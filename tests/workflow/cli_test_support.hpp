@@ -55,11 +55,16 @@ inline pid_t spawn(const std::vector<std::string>& args, const fs::path& log,
   return pid;
 }
 
+/// Exit code from a waitpid status (128 + signal when the child was killed).
+inline int exit_code(int status) {
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
 /// Exit code of the child (128 + signal when it was killed).
 inline int wait_code(pid_t pid) {
   int status = 0;
   waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return exit_code(status);
 }
 
 /// Exit code of the child, or -1 when it was still running after `seconds` (it is then sent
@@ -67,8 +72,7 @@ inline int wait_code(pid_t pid) {
 inline int wait_code_within(pid_t pid, double seconds) {
   for (double waited = 0; waited < seconds; waited += 0.05) {
     int status = 0;
-    if (waitpid(pid, &status, WNOHANG) == pid)
-      return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    if (waitpid(pid, &status, WNOHANG) == pid) return exit_code(status);
     usleep(50000);
   }
   kill(pid, SIGTERM);
