@@ -6,9 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "drape/probe_specs.hpp"
 #include "fem/model.hpp"
 
 namespace ncfsim::workflow {
+
+using drape::BendingLengthProbe;
+using drape::FabricSummary;
+using drape::ShearProbe;
 
 /// Mean displacement of a set of nodes, written to history.csv as <name>_displacement_{x,y,z}_m.
 struct DisplacementProbe {
@@ -22,14 +27,6 @@ struct ReactionProbe {
   std::vector<std::int32_t> nodes;
 };
 
-/// In-plane shear angle between the fibres of two plies over the elements whose reference centroid
-/// lies in a box (a material region): 90 deg minus the angle between the mean fibre directions.
-/// history.csv: <name>_shear_angle_deg.
-struct ShearProbe {
-  std::string name;
-  int part_a = -1, part_b = -1;
-  std::array<double, 3> box_min{}, box_max{};
-};
 
 /// Values of history columns at given values of another column, into summary.json as
 /// <label>_at_<x in display units><unit> (e.g. force_N_at_10mm). `analytic` adds the bias-extension
@@ -44,15 +41,6 @@ struct SummarySamples {
   double coupon_length = 0, coupon_width = 0;  // m (free length H, width W)
 };
 
-/// ASTM D1388 cantilever bending of a strip clamped at `root` and overhanging to `tip` under
-/// gravity: tip angle theta below the horizontal, bending length c = O (cos(theta/2) / (8 tan
-/// theta))^(1/3), flexural rigidity G = w c^3 (w = weight per area), and the beam-theory c of the
-/// part's material, (E1 t^3 / 12 / w)^(1/3). history.csv: <name>_tip_angle_deg.
-struct BendingLengthProbe {
-  std::string name;
-  int part = -1;
-  std::vector<std::int32_t> root, tip;
-};
 
 /// Mean of a history column over a time window, times a scale, into summary.json as <name>
 /// (e.g. the friction coefficient F/P of a sled over its steady sliding).
@@ -106,14 +94,6 @@ struct PictureSpec {
   double deformation_scale = 1.0;
 };
 
-/// What a [[mesh.fabric]] generated (echoed in the log and summary.json).
-struct FabricSummary {
-  std::string name;
-  std::size_t tows = 0, dropped_tows = 0, penetrations = 0, connections = 0;
-  double tow_thickness = 0;
-  // Index of its stitch-to-tow connection in model.contacts (-1: none).
-  int connection_contact = -1;
-};
 
 struct EngineCase {
   std::filesystem::path file;

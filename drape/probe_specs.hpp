@@ -1,0 +1,39 @@
+#pragma once
+// What a case asks the fabric model to measure (its probes) and what a generated blanket reports:
+// plain data read by the case reader and used by the run's measures.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace ncfsim::drape {
+
+/// In-plane shear angle between the fibres of two plies over the elements whose reference centroid
+/// lies in a box (a material region): 90 deg minus the angle between the mean fibre directions.
+/// history.csv: <name>_shear_angle_deg.
+struct ShearProbe {
+  std::string name;
+  int part_a = -1, part_b = -1;
+  std::array<double, 3> box_min{}, box_max{};
+};
+
+/// ASTM D1388 cantilever bending of a strip clamped at `root` and overhanging to `tip` under
+/// gravity: tip angle theta below the horizontal, bending length c = O (cos(theta/2) / (8 tan
+/// theta))^(1/3), flexural rigidity G = w c^3 (w = weight per area), and the beam-theory c of the
+/// part's material, (E1 t^3 / 12 / w)^(1/3). history.csv: <name>_tip_angle_deg.
+struct BendingLengthProbe {
+  std::string name;
+  int part = -1;
+  std::vector<std::int32_t> root, tip;
+};
+
+/// What a [[mesh.fabric]] generated (echoed in the log and summary.json).
+struct FabricSummary {
+  std::string name;
+  std::size_t tows = 0, dropped_tows = 0, penetrations = 0, connections = 0;
+  double tow_thickness = 0;
+  // Index of its stitch-to-tow connection in model.contacts (-1: none).
+  int connection_contact = -1;
+};
+
+}  // namespace ncfsim::drape
