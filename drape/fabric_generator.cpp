@@ -133,6 +133,10 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       // The tow's node grid (i along, m across, kz through) is a structured grid: a x b = +z.
       append_grid_hexes(mesh, part, base, {nl, nw, nt});
       fm.tow_of_hex.resize(fm.tow_of_hex.size() + static_cast<std::size_t>(nl * nw * nt), tow);
+      mesh.hex_ply.resize(mesh.hexes.size() - static_cast<std::size_t>(nl * nw * nt), -1);
+      mesh.hex_tow.resize(mesh.hex_ply.size(), -1);
+      mesh.hex_ply.resize(mesh.hexes.size(), static_cast<std::int32_t>(q));
+      mesh.hex_tow.resize(mesh.hexes.size(), tow);
     }
   }
 

@@ -29,6 +29,8 @@ void Mesh::fill_default_user_ids() {
   fill(node_user_id, n_nodes());
   fill(hex_user_id, hexes.size());
   fill(bar_user_id, bars.size());
+  hex_ply.resize(hexes.size(), -1);
+  hex_tow.resize(hexes.size(), -1);
 }
 
 void Mesh::validate() const {
@@ -36,6 +38,9 @@ void Mesh::validate() const {
   if (coords.size() % 3 != 0) throw std::invalid_argument("coordinate array is not a multiple of 3");
   if (hex_part.size() != hexes.size() || bar_part.size() != bars.size())
     throw std::invalid_argument("part tag count differs from element count");
+  if ((!hex_ply.empty() && hex_ply.size() != hexes.size()) ||
+      (!hex_tow.empty() && hex_tow.size() != hexes.size()))
+    throw std::invalid_argument("ply/tow tag count differs from the hexahedron count");
   const auto n_parts = static_cast<std::int32_t>(part_names.size());
   for (std::size_t e = 0; e < hexes.size(); ++e) {
     for (auto v : hexes[e])
@@ -111,7 +116,7 @@ std::vector<std::int32_t> renumber_for_locality(Mesh& mesh) {
     }
   std::array<double, 3> span{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
 
-  auto sort_elements = [&](auto& elems, auto& parts, auto& ids) {
+  auto sort_elements = [&](auto& elems, auto& parts, auto& ids, auto... tags) {
     auto keys = morton_keys(mesh, elems, lo, span);
     std::vector<std::size_t> order(elems.size());
     std::iota(order.begin(), order.end(), 0);
@@ -122,8 +127,9 @@ std::vector<std::int32_t> renumber_for_locality(Mesh& mesh) {
     apply_order(elems, order);
     apply_order(parts, order);
     apply_order(ids, order);
+    (apply_order(*tags, order), ...);
   };
-  sort_elements(mesh.hexes, mesh.hex_part, mesh.hex_user_id);
+  sort_elements(mesh.hexes, mesh.hex_part, mesh.hex_user_id, &mesh.hex_ply, &mesh.hex_tow);
   sort_elements(mesh.bars, mesh.bar_part, mesh.bar_user_id);
 
   std::vector<std::int32_t> new_of_old(n, -1);

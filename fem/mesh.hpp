@@ -23,6 +23,10 @@ struct Mesh {
   std::vector<std::int64_t> node_user_id;  // id for messages (defaults to 1-based input order)
   std::vector<std::int64_t> hex_user_id;
   std::vector<std::int64_t> bar_user_id;
+  // Fabric tags per hexahedron: ply index within its blanket and tow index (-1: not a tow);
+  // sized like `hexes` by fill_default_user_ids, kept with their element through renumbering.
+  std::vector<std::int32_t> hex_ply;
+  std::vector<std::int32_t> hex_tow;
 
   std::size_t n_nodes() const { return coords.size() / 3; }
   int add_part(const std::string& name);
