@@ -131,6 +131,24 @@ TEST(KinematicDrape, RingShearConvergesAsTheSpacingHalves) {
   EXPECT_LT(d2, 0.5) << q[1] << " " << q[2];
 }
 
+TEST(KinematicDrape, ShearDependsOnTheAngularPositionNotTheRadius) {
+  // Half the punch radius with half the spacing is the same net scaled: the ring at the same
+  // height-to-radius ratio reads the same shear.
+  auto at_radius = [](double R, double spacing) {
+    DrapeSurface s;
+    fem::RigidSurface ball;
+    ball.shape = fem::ToolShape::Sphere;
+    ball.radius = R;
+    s.bodies.push_back(ball);
+    auto k = pm45(spacing, 2.0 * R);
+    k.pole = {0, 0, 2 * R};
+    return ring_maxima(drape::kinematic_drape(s, k), 0.04 / 0.078 * R).max_shear_deg[0];
+  };
+  EXPECT_NEAR(at_radius(0.039, 1e-3), at_radius(0.078, 2e-3), 1e-6);
+  EXPECT_NEAR(at_radius(0.039, 2e-3), at_radius(0.078, 2e-3),
+              0.05);  // the cell size barely matters
+}
+
 TEST(RingMeasure, InterpolatesAFieldAroundACylinderAndTakesQuadrantMaxima) {
   // A vertical cylinder of radius 50 mm as a net of axial and hoop fibres; node value
   // 20 + 10 x / R: the ring reads 20 + 10 cos(azimuth) (to the chord error of the net).
