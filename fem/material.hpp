@@ -20,6 +20,9 @@ struct MaterialBatch {
   const double* strain_increment = nullptr;  // [6][strain_stride], material frame, borrowed
   double* stress = nullptr;      // [6][stride], material frame, updated in place
   double* history = nullptr;     // [n_history][stride], updated in place
+  // [3][stride] reference element lengths along the material axes (m), borrowed; null where the
+  // caller has none. Damage laws regularise their softening with them (crack band).
+  const double* length = nullptr;
   double dt = 0.0;
 };
 

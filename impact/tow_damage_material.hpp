@@ -1,0 +1,81 @@
+#pragma once
+// Impregnated tow with progressive damage, in the convected tow frame (axis 1 along the fibres;
+// Voigt 11 22 33 12 23 13, engineering shears). Orthotropic elastic (the transfer's constants),
+// then per failure mode m:
+//   initiation on the effective stress s = C0 E (maximum stress, modes kept apart):
+//     fibre_tension       f = <s11>+ / Xt           fibre_compression  f = <s11>- / Xc
+//     matrix_tension      f = max(<s22>+, <s33>+) / Yt
+//     matrix_compression  f = max(<s22>-, <s33>-) / Yc
+//     in_plane_shear      f = sqrt(s12^2 + s13^2) / S12      transverse_shear  f = |s23| / S23
+//   softening: r_m = max over the history of f_m; past r_m = 1 the damage grows linearly in the
+//   equivalent strain to full damage at r_f = 2 G_m E_m / (X_m^2 L_m) (crack band: G_m the
+//   fracture energy per area, L_m the element's length across the crack, E_m the modulus of the
+//   mode), d_m = (1 - 1/r_m) / (1 - 1/r_f), so that a uniaxial (or pure-shear) path peaks at the
+//   strength and dissipates G_m / L_m per volume whatever the mesh. r_f must exceed 1: the element
+//   must be short enough not to snap back, L_m < 2 G_m E_m / X_m^2 (checked).
+//   degradation: s11 (1 - d_ft or d_fc by its sign), s22 and s33 (1 - d_mt or d_mc by their signs),
+//   s12 and s13 (1 - d_s12)(1 - d_mt)(1 - d_ft): a cracked matrix and broken fibres carry no axial
+//   shear; s23 (1 - d_s23)(1 - d_mt).
+// History per element [kHistory][stride]: total strain (6), r per mode (6), d per mode (6).
+// The element lengths along the material axes come with the batch (MaterialBatch::length); a
+// batch without them uses `default_length`.
+#include <array>
+#include <string>
+
+#include "fem/material.hpp"
+
+namespace ncfsim::impact {
+
+enum class FailureMode {
+  FibreTension,
+  FibreCompression,
+  MatrixTension,
+  MatrixCompression,
+  InPlaneShear,
+  TransverseShear
+};
+constexpr int kModes = 6;
+/// Result-field names, in FailureMode order (damage_<name>, failed_fraction_<name>).
+constexpr std::array<const char*, kModes> kModeNames{"fibre_tension",  "fibre_compression",
+                                                     "matrix_tension", "matrix_compression",
+                                                     "in_plane_shear", "transverse_shear"};
+
+struct TowStrength {
+  double Xt = 0, Xc = 0, Yt = 0, Yc = 0, S12 = 0, S23 = 0;  // Pa, all > 0
+};
+
+/// Fracture energies per unit crack area (J/m^2), per mode in FailureMode order.
+using FractureEnergies = std::array<double, kModes>;
+
+struct TowDamageConstants {
+  double density = 0;
+  fem::OrthotropicConstants elastic{};
+  TowStrength strength;
+  FractureEnergies fracture_energy{};
+  double default_length = 1e-3;  // m, used when a batch brings no element lengths
+};
+
+class TowDamageMaterial final : public fem::SolidMaterial {
+ public:
+  static constexpr int kHistory = 18;
+  /// Throws std::invalid_argument naming the constant and its allowed range.
+  TowDamageMaterial(std::string name, const TowDamageConstants& c);
+  const std::string& name() const override { return name_; }
+  double density() const override { return c_.density; }
+  double p_wave_modulus() const override;
+  fem::Voigt6x6 elastic_stiffness() const override { return C_; }
+  int n_history() const override { return kHistory; }
+  void update_stress(const fem::MaterialBatch& b) const override;
+
+  /// The longest element (m) across a crack of mode m that does not snap back: 2 G E / X^2.
+  double max_element_length(FailureMode m) const;
+  const TowDamageConstants& constants() const { return c_; }
+
+ private:
+  std::string name_;
+  TowDamageConstants c_;
+  fem::Voigt6x6 C_{};
+  std::array<double, kModes> strength_{}, modulus_{}, rf_length_{};  // per mode; rf = rf_length / L
+};
+
+}  // namespace ncfsim::impact
