@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "fem/bar_block.hpp"
+#include "fem/elements/bar_block.hpp"
 #include "fem/contact_interface.hpp"
 #include "fem/boundary/picture_frame.hpp"
 #include "fem/material.hpp"
@@ -19,8 +19,9 @@ namespace ncfsim::fem {
 
 constexpr std::array<double, 9> kIdentityAxes{1, 0, 0, 0, 1, 0, 0, 0, 1};
 
+// What a part's elements need, by kind: the kind itself comes from the mesh (the element set the
+// part's elements are in); each group reads the fields of its kind (fem/elements/*_group.cpp).
 struct PartProperties {
-  enum class Kind { Solid, Bar } kind = Kind::Solid;
   int material = -1;  // index into Model::materials (solids)
   int bar_law = -1;   // index into Model::bar_laws (bars)
   std::array<double, 9> material_axes = kIdentityAxes;  // row-major, axes as columns, global
