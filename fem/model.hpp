@@ -65,7 +65,7 @@ struct TimeControl {
   std::int64_t max_cycles = 0;      // 0: unlimited
   double energy_balance_limit = 0.05;
   double min_step_ratio = 1e-4;     // stop when the step falls below this share of the initial one
-  double erosion_step_ratio = 0;    // 0: off; else erode a hexahedron whose step falls below this
+  double erosion_step_ratio = 0;    // 0: off; else erode an element (hexahedra) whose step falls below this
                                     // share of the initial one (LS-DYNA's ERODE with DTMIN)
 };
 
