@@ -41,10 +41,11 @@ PlyStack make_stack(int n) {
   s.f.assign(3 * nn, 0.0);
   s.ply_of_node.assign(nn, 0);
   const double m8 = kRho * kH * kH * kT / 8;
-  for (std::size_t e = 0; e < s.mesh.hexes.size(); ++e)
-    for (auto node : s.mesh.hexes[e]) {
+  const ElementSet& hexes = s.mesh.elements(ElementKind::Hex8);
+  for (std::size_t e = 0; e < hexes.size(); ++e)
+    for (auto node : hexes.nodes(e)) {
       for (int c = 0; c < 3; ++c) s.mass[3 * static_cast<std::size_t>(node) + c] += m8;
-      s.ply_of_node[static_cast<std::size_t>(node)] = s.mesh.hex_part[e];
+      s.ply_of_node[static_cast<std::size_t>(node)] = hexes.part[e];
     }
   for (std::size_t i = 0; i < nn; ++i) s.v[3 * i] = 0.1 * s.ply_of_node[i];  // shear, m/s
   return s;
@@ -60,7 +61,7 @@ void BM_StackSelfContact(benchmark::State& state) {
   cfg.groups = {{"plies", parts}};
   cfg.pairs = {{0, 0, 0.3}};
   PenaltyContact contact(cfg);
-  ContactSetup setup{&s.mesh, nullptr, s.mesh.coords.data(), s.mass.data(), kDt};
+  ContactSetup setup{&s.mesh, s.mesh.coords.data(), s.mass.data(), kDt};
   contact.initialise(setup);
   const std::size_t nd = s.x.size();
   const auto sorts0 = contact.stats().n_sorts;

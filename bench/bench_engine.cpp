@@ -29,6 +29,7 @@
 #include <string>
 #include <time.h>
 
+#include "fem/elements/hex8_block.hpp"
 #include "fem/model.hpp"
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
@@ -64,17 +65,22 @@ void shuffle_numbering(fem::Mesh& mesh, bool elements, std::mt19937_64& rng) {
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) coords[3 * static_cast<std::size_t>(new_of_old[i]) + k] = mesh.coords[3 * i + k];
   mesh.coords.swap(coords);
-  for (auto& h : mesh.hexes)
-    for (auto& v : h) v = new_of_old[static_cast<std::size_t>(v)];
-  for (auto& b : mesh.bars)
-    for (auto& v : b) v = new_of_old[static_cast<std::size_t>(v)];
-  if (elements) {
-    std::shuffle(mesh.hexes.begin(), mesh.hexes.end(), rng);  // one part: part tags unchanged
-    std::shuffle(mesh.bars.begin(), mesh.bars.end(), rng);
-  }
+  for (auto& set : mesh.sets)
+    for (auto& v : set.conn) v = new_of_old[static_cast<std::size_t>(v)];
+  if (elements)
+    for (auto kind : {fem::ElementKind::Hex8, fem::ElementKind::Bar2}) {  // the old shuffle order
+      fem::ElementSet& set = mesh.elements(kind);
+      std::vector<std::size_t> order(set.size());
+      std::iota(order.begin(), order.end(), 0);
+      std::shuffle(order.begin(), order.end(), rng);  // one part: part tags unchanged
+      const auto nn = static_cast<std::size_t>(set.nodes_per_element);
+      std::vector<std::int32_t> conn(set.conn.size());
+      for (std::size_t e = 0; e < order.size(); ++e)
+        for (std::size_t I = 0; I < nn; ++I) conn[nn * e + I] = set.conn[nn * order[e] + I];
+      set.conn.swap(conn);
+    }
   mesh.node_user_id.clear();
-  mesh.hex_user_id.clear();
-  mesh.bar_user_id.clear();
+  for (auto& set : mesh.sets) set.user_id.clear();
   mesh.fill_default_user_ids();
 }
 
@@ -120,7 +126,6 @@ Fixture& hex_fixture(Mat mat, Numbering num, bool small = false) {
   const auto div = small ? kSmallHexDiv : kHexDiv;
   fem::add_hex_block(model.mesh, p, {0, 0, 0}, {0.01 * div[0], 0.01 * div[1], 0.01 * div[2]}, div);
   model.parts.resize(1);
-  model.parts[0].kind = fem::PartProperties::Kind::Solid;
   model.parts[0].material = 0;
   if (mat == Mat::Isotropic) {
     model.materials.push_back(std::make_unique<fem::ElasticIsotropic>("steel", 7850.0, 210e9, 0.3));
@@ -155,6 +160,7 @@ Fixture& bar_fixture(const std::string& use) {
   fem::Model& model = fx->model;
   auto& mesh = model.mesh;
   const int p = mesh.add_part("stitches");
+  fem::ElementSet& bars = mesh.elements(fem::ElementKind::Bar2);
   const auto [a, b, c] = kLatticeNodes;
   const double h = 0.01;
   auto id = [&](int i, int j, int k) { return static_cast<std::int32_t>(i + a * (j + b * k)); };
@@ -168,16 +174,14 @@ Fixture& bar_fixture(const std::string& use) {
   for (int k = 0; k < c; ++k)
     for (int j = 0; j < b; ++j)
       for (int i = 0; i < a; ++i) {
-        if (i + 1 < a) mesh.bars.push_back({id(i, j, k), id(i + 1, j, k)});
-        if (j + 1 < b) mesh.bars.push_back({id(i, j, k), id(i, j + 1, k)});
-        if (k + 1 < c) mesh.bars.push_back({id(i, j, k), id(i, j, k + 1)});
+        if (i + 1 < a) bars.add({id(i, j, k), id(i + 1, j, k)}, p);
+        if (j + 1 < b) bars.add({id(i, j, k), id(i, j + 1, k)}, p);
+        if (k + 1 < c) bars.add({id(i, j, k), id(i, j, k + 1)}, p);
       }
-  mesh.bar_part.assign(mesh.bars.size(), p);
   // Polyester-yarn-like tabulated law, tension only: toe, linear, stiffening.
   model.bar_laws.emplace_back("yarn", std::vector<double>{0.0, 0.005, 0.02, 0.05, 0.1},
                               std::vector<double>{0.0, 0.5, 4.0, 15.0, 40.0}, true, 1e-5);
   model.parts.resize(1);
-  model.parts[0].kind = fem::PartProperties::Kind::Bar;
   model.parts[0].bar_law = 0;
   fem::renumber_for_locality(mesh);
   // The boundary nodes are held, so that the stretch below stays in the lattice.
@@ -236,13 +240,13 @@ void BM_HexFullCycle(benchmark::State& state, Mat mat, Numbering num) {
   const Timer t;
   for (auto _ : state) s.step();
   benchmark::DoNotOptimize(s.energy().internal);
-  report(state, "ns_per_hex_cycle", t, s.n_hexes());
+  report(state, "ns_per_hex_cycle", t, s.n_elements(fem::ElementKind::Hex8));
 }
 
 void BM_HexInternalForceOnly(benchmark::State& state, Mat mat, bool small) {
   auto& fx = hex_fixture(mat, Numbering::Local, small);
   auto& s = *fx.solver;
-  auto& blk = s.hex_blocks().at(0);
+  auto& blk = s.blocks<fem::Hex8Block>().at(0);
   auto X = s.x.view();
   auto V = s.v.view();
   auto F = s.f_int.view();
@@ -267,12 +271,12 @@ void BM_BarFullCycle(benchmark::State& state) {
   const Timer t;
   for (auto _ : state) s.step();
   benchmark::DoNotOptimize(s.energy().internal);
-  report(state, "ns_per_bar_cycle", t, s.n_bars());
+  report(state, "ns_per_bar_cycle", t, s.n_elements(fem::ElementKind::Bar2));
 }
 
 void BM_BarInternalForceOnly(benchmark::State& state) {
   auto& s = *bar_fixture("kernel").solver;
-  auto& blk = s.bar_blocks().at(0);
+  auto& blk = s.blocks<fem::BarBlock>().at(0);
   auto X = s.x.view();
   auto F = s.f_int.view();
   fem::ElementEnergyIncrement inc;

@@ -133,10 +133,11 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       // The tow's node grid (i along, m across, kz through) is a structured grid: a x b = +z.
       append_grid_hexes(mesh, part, base, {nl, nw, nt});
       fm.tow_of_hex.resize(fm.tow_of_hex.size() + static_cast<std::size_t>(nl * nw * nt), tow);
-      mesh.hex_ply.resize(mesh.hexes.size() - static_cast<std::size_t>(nl * nw * nt), -1);
-      mesh.hex_tow.resize(mesh.hex_ply.size(), -1);
-      mesh.hex_ply.resize(mesh.hexes.size(), static_cast<std::int32_t>(q));
-      mesh.hex_tow.resize(mesh.hexes.size(), tow);
+      fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
+      hexes.ply.resize(hexes.size() - static_cast<std::size_t>(nl * nw * nt), -1);
+      hexes.tow.resize(hexes.ply.size(), -1);
+      hexes.ply.resize(hexes.size(), static_cast<std::int32_t>(q));
+      hexes.tow.resize(hexes.size(), tow);
     }
   }
 
@@ -187,8 +188,7 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   };
   auto bar = [&](std::int32_t a, std::int32_t b, int part) {
     if (a < 0 || b < 0) return;
-    mesh.bars.push_back({a, b});
-    mesh.bar_part.push_back(part);
+    mesh.elements(fem::ElementKind::Bar2).add({a, b}, part);
   };
   for (int j = 0; j < nj; ++j)
     for (int i = 0; i + 1 < ni; ++i) bar(at(top, i, j), at(top, i + 1, j), fm.stitch_I_part);  // pillars, top face
@@ -217,9 +217,10 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   // Tow nodes on ply boundaries, bucketed.
   std::map<std::array<long, 2>, std::vector<std::int32_t>> grid;
   std::vector<std::int32_t> tow_of_node(mesh.n_nodes(), -1);
+  const fem::ElementSet& tow_hexes = mesh.elements(fem::ElementKind::Hex8);
   for (std::size_t e = 0; e < fm.tow_of_hex.size(); ++e) {
-    const std::size_t he = mesh.hexes.size() - fm.tow_of_hex.size() + e;
-    for (auto nd : mesh.hexes[he]) tow_of_node[static_cast<std::size_t>(nd)] = fm.tow_of_hex[e];
+    const std::size_t he = tow_hexes.size() - fm.tow_of_hex.size() + e;
+    for (auto nd : tow_hexes.nodes(he)) tow_of_node[static_cast<std::size_t>(nd)] = fm.tow_of_hex[e];
   }
   auto on_a_level = [&](double z) {
     const double k = std::round((z - bl.z0) / t);

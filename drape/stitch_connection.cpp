@@ -112,7 +112,10 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
   // turn of the offset with it then moves the hexahedron as a whole (no hourglass couple on
   // one edge). Joints sharing a hexahedron share its axis (the turn does not depend on which
   // way along the tow the axis points).
-  const auto& hexes = setup.mesh->hexes;
+  // The axis is defined on the tows' hexahedra (eight nodes, four edges along the tow); slots keep
+  // their mesh-wide element index, the index erosion reports.
+  const fem::ElementSet& hexes = setup.mesh->elements(fem::ElementKind::Hex8);
+  const auto hex_offset = static_cast<std::int32_t>(setup.mesh->element_offset(fem::ElementKind::Hex8));
   joint_slot_.assign(n, -1);
   slot_hex_.clear();
   slot_nodes_.clear();
@@ -121,7 +124,7 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
   std::vector<std::int32_t> slot_of_hex(hexes.size(), -1);
   std::vector<std::vector<std::int32_t>> hexes_at(nn);  // hexahedra by node
   for (std::size_t h = 0; h < hexes.size(); ++h)
-    for (auto nd : hexes[h])
+    for (auto nd : hexes.nodes(h))
       hexes_at[static_cast<std::size_t>(nd)].push_back(static_cast<std::int32_t>(h));
   for (std::size_t i = 0; i < n; ++i) {
     for (auto nd : {a_[i], b_[i], ax_[i]})
@@ -129,7 +132,7 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
         throw InputError("", name_, "connection joins an invalid node");
     std::int32_t hex = -1;
     for (auto h : hexes_at[static_cast<std::size_t>(b_[i])]) {
-      const auto& hx = hexes[static_cast<std::size_t>(h)];
+      const auto hx = hexes.nodes(static_cast<std::size_t>(h));
       if (std::find(hx.begin(), hx.end(), ax_[i]) != hx.end()) {
         hex = h;
         break;
@@ -140,8 +143,8 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
     auto& slot = slot_of_hex[static_cast<std::size_t>(hex)];
     if (slot < 0) {
       slot = static_cast<std::int32_t>(slot_hex_.size());
-      slot_hex_.push_back(hex);
-      const auto& hx = hexes[static_cast<std::size_t>(hex)];
+      slot_hex_.push_back(hex_offset + hex);
+      const auto hx = hexes.nodes(static_cast<std::size_t>(hex));
       const auto b = static_cast<std::size_t>(b_[i]), c = static_cast<std::size_t>(ax_[i]);
       double edge[3], cen[3] = {0, 0, 0};
       for (std::size_t k = 0; k < 3; ++k) edge[k] = x0[3 * c + k] - x0[3 * b + k];
@@ -263,8 +266,8 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
   total_ = total;
 }
 
-void StitchToTowConnection::erode(const std::vector<std::int32_t>& mesh_hexes) {
-  std::vector<std::int32_t> gone = mesh_hexes;  // erosion is rare: a sorted list to look up
+void StitchToTowConnection::erode(const std::vector<std::int32_t>& mesh_elements) {
+  std::vector<std::int32_t> gone = mesh_elements;  // erosion is rare: a sorted list to look up
   std::sort(gone.begin(), gone.end());
   for (auto& h : slot_hex_)
     if (h >= 0 && std::binary_search(gone.begin(), gone.end(), h)) h = -1;

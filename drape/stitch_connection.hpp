@@ -37,7 +37,7 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   std::vector<fem::ContactResultant> resultants() const override;
   /// A joint whose axis hexahedron (one holding its tow node and axis node) is eroded is
   /// released: that piece of tow is gone and gives no axis.
-  void erode(const std::vector<std::int32_t>& mesh_hexes) override;
+  void erode(const std::vector<std::int32_t>& mesh_elements) override;
   /// Joints released by erosion so far.
   std::size_t released() const { return n_released_; }
 

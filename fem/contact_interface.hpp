@@ -10,13 +10,11 @@
 
 namespace ncfsim::fem {
 
-struct Hex8Block;
 struct Mesh;
 
 /// What a contact may read when it is set up (after masses are assembled, before cycle 0).
 struct ContactSetup {
   const Mesh* mesh = nullptr;
-  const std::vector<Hex8Block>* hex_blocks = nullptr;
   const double* x0 = nullptr;    // reference positions [3*n_nodes]
   const double* mass = nullptr;  // lumped nodal masses [3*n_nodes] (incl. mass scaling)
   double dt = 0;                 // the initial stable step (already times the safety factor)
@@ -47,10 +45,10 @@ class ContactAlgorithm {
   virtual double stable_step_limit() const { return 1e300; }
   /// Number of active contacts after the last add_forces (diagnostics).
   virtual std::int64_t active_contacts() const { return 0; }
-  /// The hexahedra `mesh_hexes` (indices into Mesh::hexes) were eroded: their faces stop being
-  /// contact segments from the next add_forces on, and the faces of their neighbours that they
-  /// covered start being ones.
-  virtual void erode(const std::vector<std::int32_t>& mesh_hexes) { (void)mesh_hexes; }
+  /// The elements `mesh_elements` (mesh-wide indices: Mesh::element_offset of the kind plus the
+  /// index in its set) were eroded: their faces stop being contact segments from the next
+  /// add_forces on, and the faces of their neighbours that they covered start being ones.
+  virtual void erode(const std::vector<std::int32_t>& mesh_elements) { (void)mesh_elements; }
 };
 
 }  // namespace ncfsim::fem

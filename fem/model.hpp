@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "fem/bar_block.hpp"
+#include "fem/elements/bar_block.hpp"
 #include "fem/contact_interface.hpp"
 #include "fem/boundary/picture_frame.hpp"
 #include "fem/material.hpp"
@@ -19,8 +19,9 @@ namespace ncfsim::fem {
 
 constexpr std::array<double, 9> kIdentityAxes{1, 0, 0, 0, 1, 0, 0, 0, 1};
 
+// What a part's elements need, by kind: the kind itself comes from the mesh (the element set the
+// part's elements are in); each group reads the fields of its kind (fem/elements/*_group.cpp).
 struct PartProperties {
-  enum class Kind { Solid, Bar } kind = Kind::Solid;
   int material = -1;  // index into Model::materials (solids)
   int bar_law = -1;   // index into Model::bar_laws (bars)
   std::array<double, 9> material_axes = kIdentityAxes;  // row-major, axes as columns, global
@@ -64,7 +65,7 @@ struct TimeControl {
   std::int64_t max_cycles = 0;      // 0: unlimited
   double energy_balance_limit = 0.05;
   double min_step_ratio = 1e-4;     // stop when the step falls below this share of the initial one
-  double erosion_step_ratio = 0;    // 0: off; else erode a hexahedron whose step falls below this
+  double erosion_step_ratio = 0;    // 0: off; else erode an element (hexahedra) whose step falls below this
                                     // share of the initial one (LS-DYNA's ERODE with DTMIN)
 };
 

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "fem/boundary/picture_frame_motion.hpp"
 #include "fem/errors.hpp"
 
 namespace ncfsim::fem {
@@ -72,12 +73,6 @@ constexpr std::array<NodeUpdate, sizeof...(I)> node_update_table(std::index_sequ
 }
 constexpr auto kNodeUpdates = node_update_table(std::make_index_sequence<16>{});
 
-// Velocity of the frame's material point (xi, eta) at time t (d/dt of corner + xi u1 + eta u2).
-V3 frame_point_velocity(const PictureFrame& pf, double t, double xi, double eta) {
-  const double g = picture_frame_angle(pf, t), gd = 0.5 * picture_frame_rate(pf, t);
-  const double cs = std::cos(0.5 * g), sn = std::sin(0.5 * g);
-  return gd * (xi * (-sn * pf.arm1 + cs * pf.arm2) + eta * (cs * pf.arm1 - sn * pf.arm2));
-}
 }  // namespace
 
 ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
@@ -88,7 +83,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", "mesh", e.what());
   }
-  if (mesh.n_nodes() == 0 || (mesh.hexes.empty() && mesh.bars.empty()))
+  if (mesh.n_nodes() == 0 || mesh.n_elements() == 0)
     throw InputError("", "mesh", "the model has no elements");
   if (model_.parts.size() != mesh.part_names.size())
     throw InputError("", "parts", "every mesh part needs properties");
@@ -132,46 +127,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
       for (int c = 0; c < 3; ++c)
         if (pv.dofs[c]) fixed_mask_[3 * static_cast<std::size_t>(node) + c] = static_cast<std::uint8_t>(2 + k);
   }
-  // Picture-frame nodes: code 254, their frame coordinates kept per constrained DOF below.
-  std::vector<std::int32_t> frame_of_node(n, -1);
-  for (std::size_t k = 0; k < model_.picture_frames.size(); ++k) {
-    auto& pf = model_.picture_frames[k];
-    if (!(std::abs(dot(pf.arm1, pf.arm1) - 1) < 1e-9 && std::abs(dot(pf.arm2, pf.arm2) - 1) < 1e-9 &&
-          std::abs(dot(pf.arm1, pf.arm2)) < 1e-9))
-      throw InputError("", "boundary.picture_frame." + pf.name, "the arms must be orthogonal unit vectors");
-    for (auto node : pf.nodes) {
-      frame_of_node[static_cast<std::size_t>(node)] = static_cast<std::int32_t>(k);
-      for (int c = 0; c < 3; ++c) fixed_mask_[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)] = 254;
-    }
-  }
-  for (std::size_t d = 0; d < 3 * n; ++d)
-    if (fixed_mask_[d]) constrained_.push_back(d);
-  constrained_vo_.resize(constrained_.size());
-  frame_dof_.assign(constrained_.size(), {});
-  {
-    auto X0 = x0.view();
-    for (std::size_t k = 0; k < constrained_.size(); ++k) {
-      const std::size_t d = constrained_[k], node = d / 3;
-      if (fixed_mask_[d] != 254) continue;
-      const auto& pf = model_.picture_frames[static_cast<std::size_t>(frame_of_node[node])];
-      const V3 r = V3::at(X0.data() + 3 * node) - pf.corner;
-      frame_dof_[k] = {frame_of_node[node], dot(r, pf.arm1), dot(r, pf.arm2)};
-    }
-  }
-  frame_c1_.resize(model_.picture_frames.size());
-  frame_c2_.resize(model_.picture_frames.size());
-  frame_wall_power_.assign(model_.picture_frames.size(), 0.0);
-  frame_wall_active_.assign(model_.picture_frames.size(), 0);
-  for (const auto& pf : model_.picture_frames) {
-    if (!(pf.wall_penalty_scale > 0 && pf.wall_penalty_scale <= 1))
-      throw InputError("", "boundary.picture_frame." + pf.name + ".wall_penalty_scale", "must be in (0, 1]");
-    for (const auto& w : pf.walls)
-      for (auto node : w) {
-        if (node < 0 || static_cast<std::size_t>(node) >= n)
-          throw InputError("", "boundary.picture_frame." + pf.name, "wall node outside the mesh");
-        has_walls_ = true;
-      }
-  }
+  build_motions();
   zero_.assign(3 * n, 0.0);
   if (model_.velocities.size() > 250)
     throw InputError("", "boundary.velocity", "at most 250 prescribed-velocity sets");
@@ -195,13 +151,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   StableStep s;
   {
     auto X = x.view();
-    for (const auto& b : hex_) {
-      auto sb = hex8_stable_step(b, X.data());
-      if (sb.dt < s.dt) s = sb;
-    }
-    for (const auto& b : bar_)
-      for (std::size_t e = 0; e < b.n; ++e)
-        if (b.dt_crit[e] < s.dt) s = {b.dt_crit[e], b.user_id[e], true};
+    for (const auto& g : groups_) take_smaller(s, g->stable_step(X.data()));
   }
   step_ = s;
   dt_ = model_.time.safety_factor * s.dt;
@@ -222,8 +172,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   {
     auto X0 = x0.view();
     auto M = mass.view();
-    ContactSetup setup{&model_.mesh, &hex_, X0.data(),
-                       M.data(),     dt_,   model_.time.erosion_step_ratio > 0};
+    ContactSetup setup{&model_.mesh, X0.data(), M.data(), dt_, model_.time.erosion_step_ratio > 0};
     for (auto& c : model_.contacts) {
       c->initialise(setup);
       dt_ = std::min(dt_, c->stable_step_limit());
@@ -233,86 +182,79 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   vpres_.resize(model_.velocities.size());
 }
 
-std::size_t ExplicitSolver::n_hexes() const {
+std::size_t ExplicitSolver::n_elements(ElementKind kind) const {
   std::size_t s = 0;
-  for (const auto& b : hex_) s += b.n;
+  for (const auto& g : groups_)
+    if (g->kind() == kind) s += g->size();
   return s;
 }
 
-std::size_t ExplicitSolver::n_bars() const {
+std::size_t ExplicitSolver::n_elements() const {
   std::size_t s = 0;
-  for (const auto& b : bar_) s += b.n;
+  for (const auto& g : groups_) s += g->size();
   return s;
 }
 
+// One group per kind and part, kinds in ElementKind order: element forces are summed in this order.
 void ExplicitSolver::build_blocks() {
   const Mesh& mesh = model_.mesh;
   auto X = x.view();
-  for (std::size_t p = 0; p < model_.parts.size(); ++p) {
-    const PartProperties& pp = model_.parts[p];
-    const std::string& pname = mesh.part_names[p];
-    std::vector<std::size_t> hexes, bars;
-    for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
-      if (mesh.hex_part[e] == static_cast<int>(p)) hexes.push_back(e);
-    for (std::size_t e = 0; e < mesh.bars.size(); ++e)
-      if (mesh.bar_part[e] == static_cast<int>(p)) bars.push_back(e);
-    if (pp.kind == PartProperties::Kind::Solid) {
-      if (!bars.empty()) throw InputError("", "part." + pname, "a solid part holds bar elements");
-      if (hexes.empty()) continue;
-      if (pp.material < 0 || static_cast<std::size_t>(pp.material) >= model_.materials.size())
-        throw InputError("", "part." + pname + ".material", "no such material");
-      Hex8Block b;
-      b.part = static_cast<int>(p);
-      b.material = model_.materials[static_cast<std::size_t>(pp.material)].get();
-      b.n = hexes.size();
-      b.conn.resize(8 * b.n);
-      b.user_id.resize(b.n);
-      b.mesh_hex.resize(b.n);
-      for (std::size_t j = 0; j < b.n; ++j) {
-        for (int I = 0; I < 8; ++I) b.conn[I * b.n + j] = mesh.hexes[hexes[j]][I];
-        b.user_id[j] = mesh.hex_user_id[hexes[j]];
-        b.mesh_hex[j] = static_cast<std::int32_t>(hexes[j]);
-      }
-      b.hourglass_stiffness = pp.hourglass_stiffness;
-      b.hourglass_viscosity = pp.hourglass_viscosity;
-      hex8_initialise(b, X.data(), pp.material_axes);
-      hex_.push_back(std::move(b));
-    } else {
-      if (!hexes.empty()) throw InputError("", "part." + pname, "a bar part holds hexahedra");
-      if (bars.empty()) continue;
-      if (pp.bar_law < 0 || static_cast<std::size_t>(pp.bar_law) >= model_.bar_laws.size())
-        throw InputError("", "part." + pname + ".bar_law", "no such bar law");
-      BarBlock b;
-      b.part = static_cast<int>(p);
-      b.law = &model_.bar_laws[static_cast<std::size_t>(pp.bar_law)];
-      b.n = bars.size();
-      b.conn.resize(2 * b.n);
-      b.user_id.resize(b.n);
-      for (std::size_t j = 0; j < b.n; ++j) {
-        b.conn[j] = mesh.bars[bars[j]][0];
-        b.conn[b.n + j] = mesh.bars[bars[j]][1];
-        b.user_id[j] = mesh.bar_user_id[bars[j]];
-      }
-      bar_initialise(b, X.data());
-      bar_.push_back(std::move(b));
+  std::vector<int> kind_of_part(model_.parts.size(), -1);
+  for (const ElementSet& set : mesh.sets) {
+    std::vector<std::vector<std::size_t>> of_part(model_.parts.size());
+    for (std::size_t e = 0; e < set.size(); ++e) of_part[static_cast<std::size_t>(set.part[e])].push_back(e);
+    for (std::size_t p = 0; p < of_part.size(); ++p) {
+      if (of_part[p].empty()) continue;
+      if (kind_of_part[p] >= 0)
+        throw InputError("", "part." + mesh.part_names[p],
+                         std::string("a part holds both ") +
+                             element_noun(static_cast<ElementKind>(kind_of_part[p])) + " and " +
+                             element_noun(set.kind) + " elements");
+      kind_of_part[p] = static_cast<int>(set.kind);
+      groups_.push_back(make_element_group(model_, set, static_cast<int>(p), of_part[p], X.data()));
     }
   }
+  group_step_.resize(groups_.size());
+}
+
+void ExplicitSolver::build_motions() {
+  const std::size_t n = model_.mesh.n_nodes();
+  if (!model_.picture_frames.empty()) {
+    auto pf = std::make_unique<PictureFrameMotion>(model_.picture_frames);
+    frames_ = pf.get();
+    motions_.push_back(std::move(pf));
+  }
+  for (const auto& m : motions_) m->check(n);
+  // Driven nodes: code 254; the owning (motion, set) of each kept to bind its DOFs below.
+  std::vector<std::pair<std::int32_t, std::int32_t>> owner(n, {-1, -1});
+  for (std::size_t m = 0; m < motions_.size(); ++m)
+    for (std::size_t k = 0; k < motions_[m]->n_driven_sets(); ++k)
+      for (auto node : motions_[m]->driven_nodes(k)) {
+        owner[static_cast<std::size_t>(node)] = {static_cast<std::int32_t>(m), static_cast<std::int32_t>(k)};
+        for (int c = 0; c < 3; ++c) fixed_mask_[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)] = 254;
+      }
+  for (std::size_t d = 0; d < 3 * n; ++d)
+    if (fixed_mask_[d]) constrained_.push_back(d);
+  constrained_vo_.resize(constrained_.size());
+  motion_v_.assign(constrained_.size(), 0.0);
+  auto X0 = x0.view();
+  for (std::size_t k = 0; k < constrained_.size(); ++k) {
+    const std::size_t d = constrained_[k];
+    if (fixed_mask_[d] != 254) continue;
+    const auto [m, set] = owner[d / 3];
+    motions_[static_cast<std::size_t>(m)]->bind_dof(static_cast<std::size_t>(set), k, d, X0.data());
+  }
+  for (const auto& m : motions_) has_motion_forces_ = has_motion_forces_ || m->has_forces();
+}
+
+double ExplicitSolver::frame_wall_power(std::size_t k) const { return frames_ ? frames_->wall_power(k) : 0.0; }
+std::int64_t ExplicitSolver::frame_wall_contacts(std::size_t k) const {
+  return frames_ ? frames_->wall_contacts(k) : 0;
 }
 
 void ExplicitSolver::apply_mass_scaling() {
-  const double target = model_.time.mass_scaling_dt, sf = model_.time.safety_factor;
   auto X = x.view();
-  std::vector<double> dt;
-  for (auto& b : hex_) {
-    hex8_element_steps(b, X.data(), dt);
-    for (std::size_t e = 0; e < b.n; ++e)
-      if (sf * dt[e] < target) b.density[e] *= std::pow(target / (sf * dt[e]), 2);
-  }
-  for (auto& b : bar_) {
-    for (std::size_t e = 0; e < b.n; ++e)
-      if (sf * b.dt_crit[e] < target) b.mass_scale[e] = std::pow(target / (sf * b.dt_crit[e]), 2);
-    bar_initialise(b, X.data());
-  }
+  for (auto& g : groups_) g->scale_mass(X.data(), model_.time.mass_scaling_dt, model_.time.safety_factor);
 }
 
 std::string ExplicitSolver::element_position(const StableStep& st, const double* x) const {
@@ -322,58 +264,59 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
     os << "(" << c.x << ", " << c.y << ", " << c.z << ") m";
     return os.str();
   };
-  if (st.is_bar) {
-    for (const auto& b : bar_)
-      for (std::size_t e = 0; e < b.n; ++e)
-        if (b.user_id[e] == st.element) return centre(b.conn.data(), b.n, e, 2);
-  } else {
-    for (const auto& b : hex_)
-      for (std::size_t e = 0; e < b.n; ++e)
-        if (b.user_id[e] == st.element) return centre(b.conn.data(), b.n, e, 8);
-  }
+  for (const auto& g : groups_)
+    if (g->kind() == st.kind)
+      for (std::size_t e = 0; e < g->size(); ++e)
+        if (g->user_id(e) == st.element) return centre(g->conn(), g->size(), e, g->nodes_per_element());
   return "(unknown position)";
 }
 
-StableStep ExplicitSolver::erode(const double* x, const double* v, double dt_erode) {
+void ExplicitSolver::erode(const double* x, const double* v, double dt_erode) {
   const double sf = model_.time.safety_factor;
-  std::vector<std::int32_t> gone;
+  std::vector<std::int32_t> gone;  // mesh-wide element indices
   StableStep left;
-  for (auto& b : hex_) {
-    hex8_element_steps(b, x, step_scratch_, &jacobian_scratch_);
-    for (std::size_t e = 0; e < b.n; ++e) {
+  for (std::size_t k = 0; k < groups_.size(); ++k) {
+    ElementGroup& g = *groups_[k];
+    if (!g.can_erode()) continue;
+    g.element_steps(x, step_scratch_, &jacobian_scratch_);
+    const int nn = g.nodes_per_element();
+    const std::size_t offset = model_.mesh.element_offset(g.kind());
+    for (std::size_t e = 0; e < g.size(); ++e) {
       const double dt = step_scratch_[e];
       const bool folded = !(jacobian_scratch_[e] > 0);
       if (!(sf * dt < dt_erode) && !folded) {
-        if (dt < left.dt) left = {dt, b.user_id[e], false};
+        if (dt < left.dt) left = {dt, g.user_id(e), g.kind()};
         continue;
       }
       using Cause = ErosionEvent::Cause;
       const ErosionEvent ev{folded ? Cause::InvertedCorner : Cause::StableStep,
                             t_,
                             cycle_,
-                            b.user_id[e],
-                            b.part,
+                            g.user_id(e),
+                            g.kind(),
+                            g.part(),
                             sf * dt,
-                            centroid(b.conn.data(), b.n, e, 8, x)};
+                            centroid(g.conn(), g.size(), e, nn, x)};
       ErodedForce& ef = eroded_forces_.emplace_back();
-      for (int I = 0; I < 8; ++I) ef.node[I] = b.conn[static_cast<std::size_t>(I) * b.n + e];
-      hex8_element_force(b, e, x, v, ef.f);
-      energy_.eroded_internal += hex8_erode(b, e);
-      gone.push_back(b.mesh_hex[e]);
+      ef.n_nodes = nn;
+      for (int I = 0; I < nn; ++I) ef.node[I] = g.conn()[static_cast<std::size_t>(I) * g.size() + e];
+      g.element_force(e, x, v, ef.f);
+      energy_.eroded_internal += g.erode(e);
+      gone.push_back(static_cast<std::int32_t>(offset + static_cast<std::size_t>(g.set_index(e))));
       erosions_.push_back(ev);
     }
+    group_step_[k] = left;
+    left = StableStep{};
   }
   if (!gone.empty())
     for (auto& c : model_.contacts) c->erode(gone);
-  return left;
 }
 
 void ExplicitSolver::assemble_mass() {
   mass.set(0.0);
   {
     auto M = mass.view();
-    for (const auto& b : hex_) hex8_lumped_mass(b, M.data());
-    for (const auto& b : bar_) bar_lumped_mass(b, M.data());
+    for (const auto& g : groups_) g->lumped_mass(M.data());
     const std::size_t n = model_.mesh.n_nodes();
     for (std::size_t i = 0; i < n; ++i)
       if (!(M[3 * i] > 0)) {
@@ -386,61 +329,9 @@ void ExplicitSolver::assemble_mass() {
   }
   part_mass_.assign(model_.parts.size(), {});
   for (std::size_t p = 0; p < part_mass_.size(); ++p) part_mass_[p].part = model_.mesh.part_names[p];
-  for (const auto& b : hex_) {
-    const double rho = b.material->density();
-    for (std::size_t e = 0; e < b.n; ++e) {
-      part_mass_[static_cast<std::size_t>(b.part)].mass += rho * b.volume[e];
-      part_mass_[static_cast<std::size_t>(b.part)].added_mass += (b.density[e] - rho) * b.volume[e];
-    }
-  }
-  for (const auto& b : bar_) {
-    const double rho_l = b.law->linear_density();
-    for (std::size_t e = 0; e < b.n; ++e) {
-      part_mass_[static_cast<std::size_t>(b.part)].mass += rho_l * b.length0[e];
-      part_mass_[static_cast<std::size_t>(b.part)].added_mass +=
-          rho_l * (b.mass_scale[e] - 1.0) * b.length0[e];
-    }
-  }
-}
-
-void ExplicitSolver::frame_wall_forces(const double* x, const double* mass, double dt, double* fc) {
-  wall_contacts_.clear();
-  const double inv_dt2 = 1.0 / (dt * dt);
-  for (std::size_t k = 0; k < model_.picture_frames.size(); ++k) {
-    const auto& pf = model_.picture_frames[k];
-    frame_wall_active_[k] = 0;
-    if (pf.walls[0].empty() && pf.walls[1].empty()) continue;
-    const double g = picture_frame_angle(pf, t_);
-    const double cs = std::cos(0.5 * g), sn = std::sin(0.5 * g);
-    const V3 u1 = cs * pf.arm1 + sn * pf.arm2, u2 = sn * pf.arm1 + cs * pf.arm2;
-    const double s = std::sin(g), c = std::cos(g), L = pf.arm_length;
-    // In-plane unit normals: n1 to the arms along u1 (pointing towards +eta), n2 to those along u2.
-    const V3 n1 = (1.0 / c) * (u2 - s * u1), n2 = (1.0 / c) * (u1 - s * u2);
-    for (int w = 0; w < 2; ++w)
-      for (auto node : pf.walls[static_cast<std::size_t>(w)]) {
-        const auto i = static_cast<std::size_t>(node);
-        const V3 r = V3::at(x + 3 * i) - pf.corner;
-        const double b1 = dot(r, u1), b2 = dot(r, u2);
-        const double xi = (b1 - s * b2) / (c * c), eta = (b2 - s * b1) / (c * c);
-        // Signed distances to the two arms of this pair (positive inside the frame).
-        const double q = w == 0 ? eta : xi, along = w == 0 ? xi : eta;
-        if (along < 0 || along > L) continue;  // the arms are bars from pin to pin
-        const double d_lo = q * c, d_hi = (L - q) * c;
-        double depth = 0, sign = 0;
-        if (d_lo < 0) depth = -d_lo, sign = 1;
-        else if (d_hi < 0) depth = -d_hi, sign = -1;
-        else continue;
-        const double k_pen = pf.wall_penalty_scale * mass[3 * i] * inv_dt2;
-        const V3 F = (sign * k_pen * depth) * (w == 0 ? n1 : n2);
-        fc[3 * i] += F.x, fc[3 * i + 1] += F.y, fc[3 * i + 2] += F.z;
-        WallContact wc;
-        wc.frame = static_cast<std::int32_t>(k);
-        wc.xi = w == 0 ? xi : (sign > 0 ? 0.0 : L);
-        wc.eta = w == 0 ? (sign > 0 ? 0.0 : L) : eta;
-        wc.force = F;
-        wall_contacts_.push_back(wc);
-        ++frame_wall_active_[k];
-      }
+  for (const auto& g : groups_) {
+    auto& pm = part_mass_[static_cast<std::size_t>(g->part())];
+    g->add_part_mass(pm.mass, pm.added_mass);
   }
 }
 
@@ -464,7 +355,7 @@ void ExplicitSolver::check_finite(const double* vel) const {
         os << "numerical instability: velocity of node " << model_.mesh.node_user_id[i] << " at ("
            << X[3 * i] << ", " << X[3 * i + 1] << ", " << X[3 * i + 2]
            << ") m is not finite at t = " << t_ << " s, cycle " << cycle_
-           << "; the stable step is controlled by " << (step_.is_bar ? "bar " : "hexahedron ")
+           << "; the stable step is controlled by " << element_noun(step_.kind) << " "
            << step_.element << " at " << element_position(step_, X.data());
         throw NumericalError(os.str());
       }
@@ -486,7 +377,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   double* fi = Fi.data();
   // Arrays a model does not use stay zero and are neither cleared nor read in the node loop.
   const bool has_ext = !model_.loads.empty() || model_.gravity.x != 0 || model_.gravity.y != 0 || model_.gravity.z != 0;
-  const bool has_contact = !model_.tools.empty() || !model_.contacts.empty() || has_walls_;
+  const bool has_contact = !model_.tools.empty() || !model_.contacts.empty() || has_motion_forces_;
   const bool has_damp = model_.mass_damping != 0 &&
                         (model_.mass_damping_end_time <= 0 || t_ < model_.mass_damping_end_time);
   std::fill(fi, fi + nd, 0.0);
@@ -498,16 +389,23 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   StableStep st;
   {
     auto X0 = x0.view();
-    for (auto& b : hex_)
-      hex8_internal_forces(b, X.data(), Vv.data(), dt_prev_, fi, inc, st, X0.data());
+    const ElementCycleState cs{X.data(), Vv.data(), X0.data(), dt_prev_};
+    for (std::size_t k = 0; k < groups_.size(); ++k) {
+      group_step_[k] = StableStep{};
+      groups_[k]->internal_forces(cs, fi, inc, group_step_[k]);
+    }
   }
   // Erosion: a step below the limit is seen at once; folded corners, which develop over many
   // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
   const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
-  if (dt_erode > 0 &&
-      (model_.time.safety_factor * st.dt < dt_erode || cycle_ % kFoldCheckInterval == 0))
-    st = erode(X.data(), Vv.data(), dt_erode);
-  for (auto& b : bar_) bar_internal_forces(b, X.data(), fi, inc, st);
+  if (dt_erode > 0) {
+    StableStep erodible;
+    for (std::size_t k = 0; k < groups_.size(); ++k)
+      if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
+    if (model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0)
+      erode(X.data(), Vv.data(), dt_erode);
+  }
+  for (const auto& s : group_step_) take_smaller(st, s);
   energy_.internal += inc.internal;
   energy_.stabilisation += inc.stabilisation;
   energy_.hourglass += inc.hourglass;
@@ -524,7 +422,8 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     c->add_forces(X.data(), Vv.data(), M.data(), dt_c, Fc.data());
     dt_new = std::min(dt_new, c->stable_step_limit());
   }
-  if (has_walls_) frame_wall_forces(X.data(), M.data(), dt_c, Fc.data());
+  for (auto& m : motions_)
+    if (m->has_forces()) m->add_forces(t_, X.data(), M.data(), dt_c, Fc.data());
   timers_.contact += seconds_since(t0);
 
   // External forces at t^n, damping from v^{n-1/2}.
@@ -547,7 +446,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     std::ostringstream os;
     os << "numerical instability: the stable time step fell to " << dt_new << " s ("
        << dt_new / dt_initial_ << " of the initial " << dt_initial_ << " s) at t = " << t_
-       << " s, cycle " << cycle_ << "; controlled by " << (st.is_bar ? "bar " : "hexahedron ")
+       << " s, cycle " << cycle_ << "; controlled by " << element_noun(st.kind) << " "
        << st.element << " at " << element_position(st, X.data())
        << " (severely distorted or inverted)";
     throw NumericalError(os.str());
@@ -588,22 +487,14 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   ext_old *= dtp, ext_new *= dt_new, damp_old *= dtp, damp_new *= dt_new, con_old *= dtp, con_new *= dt_new;
   ke *= 0.5;
   const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
-  for (std::size_t k = 0; k < model_.picture_frames.size(); ++k) {  // d(u1)/dt, d(u2)/dt at t^{n+1/2}
-    const auto& pf = model_.picture_frames[k];
-    const double g = picture_frame_angle(pf, t_half), gd = 0.5 * picture_frame_rate(pf, t_half);
-    const double cs = std::cos(0.5 * g), sn = std::sin(0.5 * g);
-    frame_c1_[k] = gd * (-sn * pf.arm1 + cs * pf.arm2);
-    frame_c2_[k] = gd * (cs * pf.arm1 - sn * pf.arm2);
-  }
+  for (auto& m : motions_) m->velocities(t_half, motion_v_.data());
   for (std::size_t k = 0; k < constrained_.size(); ++k) {
     const std::size_t d = constrained_[k];
     const std::uint8_t code = fixed_mask_[d];
     const double vo = constrained_vo_[k], m = mm[d], vfree = vel[d];
     double vp = 0.0;
     if (code == 254) {
-      const FrameDof& fd = frame_dof_[k];
-      const auto f = static_cast<std::size_t>(fd.frame);
-      vp = (fd.xi * frame_c1_[f] + fd.eta * frame_c2_[f]).arr()[d % 3];
+      vp = motion_v_[k];
     } else if (code > 1) {
       vp = vpres[code - 2].arr()[d % 3];
     }
@@ -620,7 +511,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   }
   w_ext_.add(ext_old, ext_new);
   for (const auto& ef : eroded_forces_)  // see ErodedForce
-    for (int I = 0; I < 8; ++I)
+    for (int I = 0; I < ef.n_nodes; ++I)
       for (int c = 0; c < 3; ++c)
         energy_.internal +=
             0.5 * ef.f[3 * I + c] * dt_new * vel[3 * static_cast<std::size_t>(ef.node[I]) + c];
@@ -654,20 +545,12 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       tool_src_new += dot(F, dt_new * vn);
     }
   }
-  // Frame walls: kinematically driven like velocity tools, so their work on the nodes is the
-  // frame's (external) work; the contact energy keeps the penalty energy stored.
-  if (has_walls_) {
-    std::fill(frame_wall_power_.begin(), frame_wall_power_.end(), 0.0);
-    const double t_old = t_ - 0.5 * dt_prev_;
-    for (const auto& wc : wall_contacts_) {
-      const auto& pf = model_.picture_frames[static_cast<std::size_t>(wc.frame)];
-      const double p_old = dot(wc.force, frame_point_velocity(pf, t_old, wc.xi, wc.eta));
-      const double p_new = dot(wc.force, frame_point_velocity(pf, t_half, wc.xi, wc.eta));
-      frame_wall_power_[static_cast<std::size_t>(wc.frame)] += p_new;
-      tool_src_old += dt_prev_ * p_old, tool_src_new += dt_new * p_new;
-      tool_on_nodes_old += dt_prev_ * p_old, tool_on_nodes_new += dt_new * p_new;
-    }
-  }
+  // Rigs' walls: driven like velocity tools, so their work on the nodes is the rig's (external)
+  // work; the contact energy keeps the penalty energy stored.
+  for (auto& m : motions_)
+    if (m->has_forces())
+      m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, tool_src_old, tool_src_new,
+                        tool_on_nodes_old, tool_on_nodes_new);
   w_tools_.add(tool_src_old, tool_src_new);
   tool_work_on_nodes_.add(tool_on_nodes_old, tool_on_nodes_new);
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "fem/bar_block.hpp"
+#include "fem/boundary/boundary_motion.hpp"
+#include "fem/elements/element_group.hpp"
 #include "fem/energy.hpp"
-#include "fem/hex8_block.hpp"
 #include "fem/model.hpp"
 #include "fem/petsc_vector.hpp"
 
@@ -22,13 +22,38 @@ struct PartMassReport {
   double added_mass = 0;  // mass added by mass scaling, kg
 };
 
-/// One hexahedron removed by erosion.
+class PictureFrameMotion;
+
+/// The blocks of one kind among the solver's element groups, in group order (range-for, [], at).
+template <class Block>
+class BlockList {
+ public:
+  explicit BlockList(std::vector<Block*> b) : b_(std::move(b)) {}
+  struct iterator {
+    typename std::vector<Block*>::const_iterator it;
+    Block& operator*() const { return **it; }
+    iterator& operator++() { return ++it, *this; }
+    bool operator==(const iterator& o) const { return it == o.it; }
+  };
+  iterator begin() const { return {b_.begin()}; }
+  iterator end() const { return {b_.end()}; }
+  std::size_t size() const { return b_.size(); }
+  bool empty() const { return b_.empty(); }
+  Block& operator[](std::size_t i) const { return *b_[i]; }
+  Block& at(std::size_t i) const { return *b_.at(i); }
+
+ private:
+  std::vector<Block*> b_;
+};
+
+/// One element removed by erosion.
 struct ErosionEvent {
   enum class Cause { StableStep, InvertedCorner };
   Cause cause = Cause::StableStep;
   double time = 0;
   std::int64_t cycle = 0;
   std::int64_t element = 0;  // user id
+  ElementKind kind = ElementKind::Hex8;
   int part = 0;
   double step = 0;  // its stable step when eroded (times the safety factor), s
   V3 centroid;      // m
@@ -53,18 +78,31 @@ class ExplicitSolver {
   const EnergyBalance& energy() const { return energy_; }
   const StableStep& controlling_element() const { return step_; }
   const std::vector<PartMassReport>& part_masses() const { return part_mass_; }
-  /// Hexahedra eroded so far (time.erosion_step_ratio), in order.
+  /// Elements eroded so far (time.erosion_step_ratio), in order.
   const std::vector<ErosionEvent>& erosions() const { return erosions_; }
   const PhaseTimers& timers() const { return timers_; }
-  std::size_t n_hexes() const;
-  std::size_t n_bars() const;
+  std::size_t n_elements(ElementKind kind) const;
+  std::size_t n_elements() const;
 
   Model& model() { return model_; }
   const Model& model() const { return model_; }
-  std::vector<Hex8Block>& hex_blocks() { return hex_; }
-  std::vector<BarBlock>& bar_blocks() { return bar_; }
-  const std::vector<Hex8Block>& hex_blocks() const { return hex_; }
-  const std::vector<BarBlock>& bar_blocks() const { return bar_; }
+  /// Element groups (one per kind and part, kinds in ElementKind order, parts ascending).
+  const std::vector<std::unique_ptr<ElementGroup>>& groups() const { return groups_; }
+  /// The groups of one kind as their blocks (Hex8Block, BarBlock, ...).
+  template <class Block>
+  BlockList<Block> blocks() {
+    std::vector<Block*> b;
+    for (auto& g : groups_)
+      if (Block* p = block_of<Block>(*g)) b.push_back(p);
+    return BlockList<Block>(std::move(b));
+  }
+  template <class Block>
+  BlockList<const Block> blocks() const {
+    std::vector<const Block*> b;
+    for (const auto& g : groups_)
+      if (const Block* p = block_of<Block>(*g)) b.push_back(p);
+    return BlockList<const Block>(std::move(b));
+  }
 
   // Nodal state, [3*n_nodes] each.
   NodalVector x0, x, v, mass, f_int, f_ext, f_contact, f_damp, reaction;
@@ -73,25 +111,28 @@ class ExplicitSolver {
   V3 reaction_force(const std::vector<std::int32_t>& nodes) const;
   /// Power (W) the walls of picture frame k (its arms, PictureFrame::walls) put into the nodes
   /// at t^{n+1/2} of the last cycle; 0 without walls.
-  double frame_wall_power(std::size_t k) const { return k < frame_wall_power_.size() ? frame_wall_power_[k] : 0.0; }
+  double frame_wall_power(std::size_t k) const;
   /// Nodes in contact with the walls of picture frame k in the last cycle.
-  std::int64_t frame_wall_contacts(std::size_t k) const { return k < frame_wall_active_.size() ? frame_wall_active_[k] : 0; }
+  std::int64_t frame_wall_contacts(std::size_t k) const;
 
  private:
   void build_blocks();
   void apply_mass_scaling();
   void assemble_mass();
   void check_finite(const double* vel) const;
-  /// Erodes every hexahedron whose step at x (times the safety factor) is below dt_erode or
-  /// one of whose corners has folded over (corner Jacobian <= 0); returns the stable step of
-  /// those left.
-  StableStep erode(const double* x, const double* v, double dt_erode);
+  void build_motions();
+  /// Erodes every element of the groups that can lose elements whose step at x (times the
+  /// safety factor) is below dt_erode or one of whose corners has folded over (corner Jacobian
+  /// <= 0); those groups' steps (group_step_) become the stable step of the elements left.
+  void erode(const double* x, const double* v, double dt_erode);
   /// "(x, y, z) m": centroid at x of the element a StableStep names (for messages).
   std::string element_position(const StableStep& st, const double* x) const;
 
   Model& model_;
-  std::vector<Hex8Block> hex_;
-  std::vector<BarBlock> bar_;
+  std::vector<std::unique_ptr<ElementGroup>> groups_;
+  std::vector<StableStep> group_step_;  // per group, this cycle
+  std::vector<std::unique_ptr<BoundaryMotion>> motions_;  // rigs that drive nodes (picture frames)
+  PictureFrameMotion* frames_ = nullptr;                   // among motions_
   std::vector<PartMassReport> part_mass_;
   std::vector<ErosionEvent> erosions_;
   std::vector<double> step_scratch_, jacobian_scratch_;
@@ -99,35 +140,22 @@ class ExplicitSolver {
   /// first half of the next increment, which the trapezoidal external work counts, is booked
   /// as internal energy once the increment is known (the element no longer does it).
   struct ErodedForce {
-    std::int32_t node[8];
-    double f[24];
+    int n_nodes = 0;
+    std::int32_t node[kMaxNodesPerElement];
+    double f[3 * kMaxNodesPerElement];
   };
   std::vector<ErodedForce> eroded_forces_;
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
-  std::vector<V3> vpres_;
-  struct FrameDof {
-    std::int32_t frame = -1;
-    double xi = 0, eta = 0;  // reference coordinates along the frame's arms
-  };
-  std::vector<FrameDof> frame_dof_;       // per constrained DOF (frame = -1: not a frame DOF)
-  std::vector<V3> frame_c1_, frame_c2_;   // per frame: d(u1)/dt, d(u2)/dt this cycle
-  struct WallContact {
-    std::int32_t frame = -1;
-    double xi = 0, eta = 0;  // frame coordinates of the contact point on the arm
-    V3 force;                // on the node, at t^n
-  };
-  std::vector<WallContact> wall_contacts_;  // this cycle's
-  std::vector<double> frame_wall_power_;
-  std::vector<std::int64_t> frame_wall_active_;
-  bool has_walls_ = false;
-  void frame_wall_forces(const double* x, const double* mass, double dt, double* fc);
+  std::vector<V3> vpres_;  // prescribed velocities at t^{n+1/2}, one per set
+  std::vector<double> motion_v_;  // per constrained DOF: velocity from its boundary motion
+  bool has_motion_forces_ = false;
   std::vector<std::size_t> constrained_;  // DOFs with a fixed or prescribed velocity
   std::vector<double> constrained_vo_;    // their v^{n-1/2} during a cycle
   std::vector<double> zero_;              // [3*n] zeros for force arrays a model does not use
   bool f_damp_zero_ = false;              // f_damp holds zeros (no damping since it was cleared)
   std::vector<double> inv_mass_;      // [3*n] 1 / lumped mass
-  std::vector<double> gravity_mass_;  // [3*n] physical nodal masses (no mass scaling)  // prescribed velocities at t^{n+1/2}, one per set
+  std::vector<double> gravity_mass_;  // [3*n] physical nodal masses (no mass scaling)
   std::int64_t cycle_ = 0;
   StableStep step_;
   EnergyBalance energy_;

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "fem/hex8_block.hpp"
+#include "fem/elements/hex8_block.hpp"
 #include "fem/material.hpp"
 
 namespace ncfsim::test {

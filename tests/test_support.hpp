@@ -44,7 +44,6 @@ inline void add_elastic_block(fem::Model& model, const std::string& part, std::a
   fem::add_hex_block(model.mesh, p, origin, size, div);
   model.materials.push_back(std::make_unique<fem::ElasticIsotropic>(part + "_mat", rho, E, nu));
   if (static_cast<int>(model.parts.size()) <= p) model.parts.resize(static_cast<std::size_t>(p) + 1);
-  model.parts[static_cast<std::size_t>(p)].kind = fem::PartProperties::Kind::Solid;
   model.parts[static_cast<std::size_t>(p)].material = static_cast<int>(model.materials.size()) - 1;
 }
 

@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
       if (const int code = refuse_many_ranks()) return code;
       ncfsim::fem::ExplicitSolver probe(ec.model);
       std::printf("%s: OK (case '%s', %zu nodes, %zu hexahedra, %zu bars, stable step %.4g s, about %.3g cycles)\n",
-                  case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(), probe.n_hexes(), probe.n_bars(),
+                  case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(), probe.n_elements(ncfsim::fem::ElementKind::Hex8), probe.n_elements(ncfsim::fem::ElementKind::Bar2),
                   probe.time_step(), ec.model.time.end_time / probe.time_step());
       return wf::kSuccess;
     }

@@ -12,16 +12,14 @@ namespace ncfsim::fem {
 
 namespace {
 
-// Faces of the VTK hexahedron, corners counter-clockwise seen from outside (outward normal by
-// the right-hand rule), and the face opposite each.
-constexpr int kFace[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                             {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-constexpr int kOpposite[6] = {1, 0, 4, 5, 2, 3};
-
+// Element faces (fem/elements/element_kind.hpp): corners counter-clockwise seen from outside
+// (outward normal by the right-hand rule), and the face opposite each.
 struct FaceRecord {
   std::array<std::int32_t, 4> key;  // sorted corners
-  std::int32_t hex;
+  std::int32_t hex;                 // mesh-wide element index
   std::int32_t face;
+  std::int32_t set;   // in Mesh::sets
+  std::int32_t elem;  // in its set
   bool operator<(const FaceRecord& o) const { return key < o.key; }
 };
 
@@ -53,7 +51,9 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
     }
   }
   std::vector<std::size_t> hexes_of_part(static_cast<std::size_t>(n_parts), 0);
-  for (auto p : mesh.hex_part) ++hexes_of_part[static_cast<std::size_t>(p)];
+  for (const ElementSet& set : mesh.sets)
+    if (!element_faces(set.kind).empty())
+      for (auto p : set.part) ++hexes_of_part[static_cast<std::size_t>(p)];
   for (const auto& grp : groups)
     for (int p : grp.parts)
       if (hexes_of_part[static_cast<std::size_t>(p)] == 0)
@@ -65,16 +65,23 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
   std::vector<FaceRecord> faces;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     faces.clear();
-    for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
-      if (group_of_part[static_cast<std::size_t>(mesh.hex_part[e])] != static_cast<int>(g))
-        continue;
-      for (int f = 0; f < 6; ++f) {
-        FaceRecord r;
-        for (int k = 0; k < 4; ++k) r.key[k] = mesh.hexes[e][kFace[f][k]];
-        std::sort(r.key.begin(), r.key.end());
-        r.hex = static_cast<std::int32_t>(e);
-        r.face = f;
-        faces.push_back(r);
+    for (std::size_t q = 0; q < mesh.sets.size(); ++q) {
+      const ElementSet& set = mesh.sets[q];
+      const auto kface = element_faces(set.kind);
+      const std::size_t offset = mesh.element_offset(set.kind);
+      for (std::size_t e = 0; e < set.size() && !kface.empty(); ++e) {
+        if (group_of_part[static_cast<std::size_t>(set.part[e])] != static_cast<int>(g)) continue;
+        const auto h = set.nodes(e);
+        for (std::size_t f = 0; f < kface.size(); ++f) {
+          FaceRecord r;
+          for (int k = 0; k < 4; ++k) r.key[k] = h[static_cast<std::size_t>(kface[f].corner[k])];
+          std::sort(r.key.begin(), r.key.end());
+          r.hex = static_cast<std::int32_t>(offset + e);
+          r.face = static_cast<std::int32_t>(f);
+          r.set = static_cast<std::int32_t>(q);
+          r.elem = static_cast<std::int32_t>(e);
+          faces.push_back(r);
+        }
       }
     }
     std::sort(faces.begin(), faces.end());
@@ -85,23 +92,28 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
       // segment from each side (dormant until the other hexahedron is eroded).
       const bool inner = j == i + 2 && interior_faces;
       for (std::size_t r = i; r < (inner ? i + 2 : (j == i + 1 ? i + 1 : i)); ++r) {
-        const auto& h = mesh.hexes[static_cast<std::size_t>(faces[r].hex)];
-        const int f = faces[r].face;
+        const ElementSet& set = mesh.sets[static_cast<std::size_t>(faces[r].set)];
+        const auto elem = static_cast<std::size_t>(faces[r].elem);
+        const auto h = set.nodes(elem);
+        const ElementFace& face = element_faces(set.kind)[static_cast<std::size_t>(faces[r].face)];
+        const auto& fc = face.corner;
+        const auto& oc = element_faces(set.kind)[static_cast<std::size_t>(face.opposite)].corner;
+        auto at = [&](int local) { return h[static_cast<std::size_t>(local)]; };
         V3 c, co;
         for (int k = 0; k < 4; ++k) {
-          c += 0.25 * node_at(x0, h[kFace[f][k]]);
-          co += 0.25 * node_at(x0, h[kFace[kOpposite[f]][k]]);
+          c += 0.25 * node_at(x0, at(fc[k]));
+          co += 0.25 * node_at(x0, at(oc[k]));
         }
-        const V3 a = node_at(x0, h[kFace[f][2]]) - node_at(x0, h[kFace[f][0]]);
-        const V3 b = node_at(x0, h[kFace[f][3]]) - node_at(x0, h[kFace[f][1]]);
+        const V3 a = node_at(x0, at(fc[2])) - node_at(x0, at(fc[0]));
+        const V3 b = node_at(x0, at(fc[3])) - node_at(x0, at(fc[1]));
         const V3 n = normalized(cross(a, b));
-        for (int k = 0; k < 4; ++k) s.seg_nodes.push_back(h[kFace[f][k]]);
-        for (int k = 0; k < 8; ++k) s.seg_elem_nodes.push_back(h[k]);
+        for (int k = 0; k < 4; ++k) s.seg_nodes.push_back(at(fc[k]));
+        for (auto v : h) s.seg_elem_nodes.push_back(v);
         s.seg_group.push_back(static_cast<std::int32_t>(g));
         s.seg_elem_thickness.push_back(std::abs(dot(co - c, n)));
-        s.seg_elem_user_id.push_back(mesh.hex_user_id.size() == mesh.hexes.size()
-                                         ? mesh.hex_user_id[static_cast<std::size_t>(faces[r].hex)]
-                                         : faces[r].hex + 1);
+        s.seg_elem_user_id.push_back(set.user_id.size() == set.size()
+                                         ? set.user_id[elem]
+                                         : static_cast<std::int64_t>(elem) + 1);
         s.seg_hex.push_back(faces[r].hex);
         s.seg_cover_hex.push_back(inner ? faces[r == i ? i + 1 : i].hex : -1);
       }

@@ -21,7 +21,7 @@ struct ContactSurface {
   std::vector<double>
       seg_elem_thickness;  // [n_seg] owning hexahedron's thickness normal to the face at x0, m
   std::vector<std::int64_t> seg_elem_user_id;  // [n_seg] for messages
-  std::vector<std::int32_t> seg_hex;           // [n_seg] owning hexahedron (index into Mesh::hexes)
+  std::vector<std::int32_t> seg_hex;           // [n_seg] owning element (mesh-wide index, Mesh::element_offset)
   // [n_seg] -1: an outer face; else an inner face (only with interior_faces), covered by this
   // hexahedron of the same group: a surface segment only once that one is eroded.
   std::vector<std::int32_t> seg_cover_hex;

@@ -135,8 +135,8 @@ void PenaltyContact::collect_active_segments() {
     if (seg_in_pair_[s] && !seg_off(s)) active_seg_.push_back(static_cast<std::int32_t>(s));
 }
 
-void PenaltyContact::erode(const std::vector<std::int32_t>& mesh_hexes) {
-  std::vector<std::int32_t> gone(mesh_hexes);
+void PenaltyContact::erode(const std::vector<std::int32_t>& mesh_elements) {
+  std::vector<std::int32_t> gone(mesh_elements);
   std::sort(gone.begin(), gone.end());
   auto eroded = [&](std::int32_t h) { return std::binary_search(gone.begin(), gone.end(), h); };
   bool any = false;

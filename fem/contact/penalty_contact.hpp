@@ -80,7 +80,7 @@ class PenaltyContact final : public ContactAlgorithm {
   std::int64_t active_contacts() const override { return stats_.n_active; }
   /// Faces of eroded hexahedra leave the surface; the faces of their neighbours in the same group
   /// that they covered join it (set up when the solver erodes: ContactSetup::erosion).
-  void erode(const std::vector<std::int32_t>& mesh_hexes) override;
+  void erode(const std::vector<std::int32_t>& mesh_elements) override;
 
   const PenaltyContactConfig& config() const { return cfg_; }
   const ContactSurface& surface() const { return surf_; }

@@ -182,10 +182,10 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
   force_ = {Rx, Ry, Rz};
 }
 
-void TiedContact::erode(const std::vector<std::int32_t>& mesh_hexes) {
+void TiedContact::erode(const std::vector<std::int32_t>& mesh_elements) {
   for (std::size_t t = 0; t < node_.size(); ++t)
     if (alive_[t] &&
-        std::find(mesh_hexes.begin(), mesh_hexes.end(), seg_hex_[t]) != mesh_hexes.end())
+        std::find(mesh_elements.begin(), mesh_elements.end(), seg_hex_[t]) != mesh_elements.end())
       alive_[t] = 2;
 }
 

@@ -30,7 +30,7 @@ class TiedContact final : public ContactAlgorithm {
   /// Ties still holding.
   std::int64_t active_contacts() const override { return n_alive_; }
   /// Ties on faces of eroded hexahedra fail in the next add_forces (their energy released).
-  void erode(const std::vector<std::int32_t>& mesh_hexes) override;
+  void erode(const std::vector<std::int32_t>& mesh_elements) override;
 
   const TiedContactConfig& config() const { return cfg_; }
   std::size_t n_ties() const { return node_.size(); }

@@ -12,8 +12,9 @@ namespace ncfsim::test {
 /// Nodes of the hexahedra of part p, sorted.
 inline std::vector<std::int32_t> part_nodes(const fem::Mesh& m, int p) {
   std::vector<std::int32_t> out;
-  for (std::size_t e = 0; e < m.hexes.size(); ++e)
-    if (m.hex_part[e] == p) out.insert(out.end(), m.hexes[e].begin(), m.hexes[e].end());
+  const fem::ElementSet& hexes = m.elements(fem::ElementKind::Hex8);
+  for (std::size_t e = 0; e < hexes.size(); ++e)
+    if (hexes.part[e] == p) out.insert(out.end(), hexes.nodes(e).begin(), hexes.nodes(e).end());
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;

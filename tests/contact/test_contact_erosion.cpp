@@ -115,9 +115,10 @@ TEST(ContactErosion, FaceUncoveredByErosionCatchesTheBlock) {
   model.time.end_time = 1.0;
   model.time.erosion_step_ratio = 1e-6;  // erosion possible; nothing reaches it by itself
   std::int32_t top_hex = -1;
-  for (std::size_t e = 0; e < model.mesh.hexes.size(); ++e)
-    if (model.mesh.hex_part[e] == 0 &&
-        model.mesh.coords[3 * static_cast<std::size_t>(model.mesh.hexes[e][6]) + 2] > 0.9 * kL)
+  const fem::ElementSet& hexes = model.mesh.elements(fem::ElementKind::Hex8);
+  for (std::size_t e = 0; e < hexes.size(); ++e)
+    if (hexes.part[e] == 0 &&
+        model.mesh.coords[3 * static_cast<std::size_t>(hexes.nodes(e)[6]) + 2] > 0.9 * kL)
       top_hex = static_cast<std::int32_t>(e);
   ASSERT_GE(top_hex, 0);
   fem::PenaltyContactConfig cfg;

@@ -90,10 +90,11 @@ TEST(ContactStack, TwentyStripsPressedAndShearedNeverPassThroughEachOther) {
     for (auto i : test::part_nodes_at(mesh, k, 2, k * kT)) {
       const double* p = &X[3 * static_cast<std::size_t>(i)];
       bool over = false;
-      for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
-        if (mesh.hex_part[e] != k - 1) continue;
-        const std::int32_t top_face[4] = {mesh.hexes[e][4], mesh.hexes[e][5], mesh.hexes[e][6],
-                                          mesh.hexes[e][7]};
+      const fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
+      for (std::size_t e = 0; e < hexes.size(); ++e) {
+        if (hexes.part[e] != k - 1) continue;
+        const auto h = hexes.nodes(e);
+        const std::int32_t top_face[4] = {h[4], h[5], h[6], h[7]};
         double q[4][3];
         fem::gather_segment(X.data(), top_face, q);
         fem::SegmentFrame f;

@@ -15,10 +15,11 @@ fem::Mesh two_part_block(int n) {
   const int a = m.add_part("left");
   m.add_part("right");
   fem::add_hex_block(m, a, {0, 0, 0}, {1, 1, 1}, {n, n, n});
-  for (std::size_t e = 0; e < m.hexes.size(); ++e) {
+  fem::ElementSet& hexes = m.elements(fem::ElementKind::Hex8);
+  for (std::size_t e = 0; e < hexes.size(); ++e) {
     double cx = 0;
-    for (auto v : m.hexes[e]) cx += m.coords[3 * static_cast<std::size_t>(v)] / 8;
-    m.hex_part[e] = cx < 0.5 ? 0 : 1;
+    for (auto v : hexes.nodes(e)) cx += m.coords[3 * static_cast<std::size_t>(v)] / 8;
+    hexes.part[e] = cx < 0.5 ? 0 : 1;
   }
   m.fill_default_user_ids();
   return m;

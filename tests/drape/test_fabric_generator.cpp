@@ -45,7 +45,7 @@ TEST(FabricGenerator, CountsOfASquareBlanket) {
   const auto& m = b.mesh;
   ASSERT_EQ(b.fm.ply_parts.size(), 2u);
   // Every hexahedron belongs to a tow; per tow nl x nw x nt elements with nl >= 2.
-  EXPECT_EQ(b.fm.tow_of_hex.size(), m.hexes.size());
+  EXPECT_EQ(b.fm.tow_of_hex.size(), m.elements(fem::ElementKind::Hex8).size());
   std::vector<int> per_tow(b.fm.n_tows, 0);
   for (auto t : b.fm.tow_of_hex) ++per_tow[static_cast<std::size_t>(t)];
   for (int c : per_tow) {
@@ -61,7 +61,7 @@ TEST(FabricGenerator, CountsOfASquareBlanket) {
   const int ny = static_cast<int>(std::floor(L / f.gauge()));
   EXPECT_EQ(b.fm.n_penetrations, static_cast<std::size_t>(nx * ny));
   std::map<int, int> bars_per_part;
-  for (auto p : m.bar_part) ++bars_per_part[p];
+  for (auto p : m.elements(fem::ElementKind::Bar2).part) ++bars_per_part[p];
   EXPECT_EQ(bars_per_part[b.fm.stitch_I_part], (nx - 1) * ny);
   EXPECT_EQ(bars_per_part[b.fm.stitch_Lambda_part], (nx - 1) * (ny - 1));
   EXPECT_EQ(bars_per_part[b.fm.stitch_leg_part], 2 * nx * ny);
@@ -75,10 +75,10 @@ TEST(FabricGenerator, TowsOfAPlyDoNotOverlap) {
   const auto& m = b.mesh;
   // Across-tow coordinate interval of every tow, per ply: neighbours are separated by the gap.
   std::map<std::int32_t, std::pair<double, double>> span;
-  for (std::size_t e = 0; e < m.hexes.size(); ++e) {
+  for (std::size_t e = 0; e < m.elements(fem::ElementKind::Hex8).size(); ++e) {
     const int ply = b.fm.ply_of_tow[static_cast<std::size_t>(b.fm.tow_of_hex[e])];
     const double al = f.ply_angles_deg[static_cast<std::size_t>(ply)] * M_PI / 180;
-    for (auto nd : m.hexes[e]) {
+    for (auto nd : m.elements(fem::ElementKind::Hex8).nodes(e)) {
       const double v = -std::sin(al) * m.coords[3 * nd] + std::cos(al) * m.coords[3 * nd + 1];
       auto [it, fresh] = span.try_emplace(b.fm.tow_of_hex[e], v, v);
       it->second.first = std::min(it->second.first, v);
@@ -93,9 +93,9 @@ TEST(FabricGenerator, TowsOfAPlyDoNotOverlap) {
     }
   // Each element has a positive volume proxy: tows lie in their ply's z slab.
   const double t = f.tow_thickness();
-  for (std::size_t e = 0; e < m.hexes.size(); ++e) {
+  for (std::size_t e = 0; e < m.elements(fem::ElementKind::Hex8).size(); ++e) {
     const int ply = b.fm.ply_of_tow[static_cast<std::size_t>(b.fm.tow_of_hex[e])];
-    for (auto nd : m.hexes[e]) {
+    for (auto nd : m.elements(fem::ElementKind::Hex8).nodes(e)) {
       EXPECT_GE(m.coords[3 * nd + 2], ply * t - 1e-12);
       EXPECT_LE(m.coords[3 * nd + 2], (ply + 1) * t + 1e-12);
     }
@@ -116,17 +116,16 @@ TEST_P(StitchJoints, EveryStitchBarIsJoinedAtBothEnds) {
   const auto b = build(f, 0.04, 0.04);
   std::set<std::int32_t> connected;
   for (const auto& c : b.fm.connections) connected.insert(c.stitch_node);
-  ASSERT_FALSE(b.mesh.bars.empty());
-  for (const auto& bar : b.mesh.bars)
-    for (auto nd : bar) EXPECT_TRUE(connected.count(nd)) << "stitch node " << nd << " is joined to no tow";
+  ASSERT_FALSE(b.mesh.elements(fem::ElementKind::Bar2).empty());
+  for (auto nd : b.mesh.elements(fem::ElementKind::Bar2).conn) EXPECT_TRUE(connected.count(nd)) << "stitch node " << nd << " is joined to no tow";
   // A penetration point lies in a gap: on each face it meets two neighbouring tows, each at least
   // half a gap away; on the interface it meets those of both plies, so the plies are pinned to
   // each other there.
   std::map<std::int32_t, int> per_node;
   std::map<std::int32_t, std::set<int>> plies_of_node;
   std::map<std::int32_t, int> ply_of_node, tow_of_node;
-  for (std::size_t e = 0; e < b.mesh.hexes.size(); ++e)
-    for (auto nd : b.mesh.hexes[e]) {
+  for (std::size_t e = 0; e < b.mesh.elements(fem::ElementKind::Hex8).size(); ++e)
+    for (auto nd : b.mesh.elements(fem::ElementKind::Hex8).nodes(e)) {
       ply_of_node[nd] = b.fm.ply_of_tow[static_cast<std::size_t>(b.fm.tow_of_hex[e])];
       tow_of_node[nd] = b.fm.tow_of_hex[e];
     }
@@ -215,8 +214,7 @@ TEST(FabricGenerator, RotatedStitchLattice) {
   EXPECT_GT(b.fm.n_penetrations, 20u);
   std::set<std::int32_t> connected;
   for (const auto& c : b.fm.connections) connected.insert(c.stitch_node);
-  for (const auto& bar : b.mesh.bars)
-    for (auto nd : bar) EXPECT_TRUE(connected.count(nd)) << "stitch node " << nd << " is joined to no tow";
+  for (auto nd : b.mesh.elements(fem::ElementKind::Bar2).conn) EXPECT_TRUE(connected.count(nd)) << "stitch node " << nd << " is joined to no tow";
   // Each penetration point lies in a gap of the 0 deg ply (y between tows) and of the 90 deg ply.
   const double p = f.tow_pitch();
   for (auto nd : b.fm.stitch_nodes) {

@@ -77,7 +77,7 @@ fem::Mesh one_joint_mesh() {
     for (auto [x, y] :
          {std::pair{0.0, 0.0}, std::pair{1e-3, 0.0}, std::pair{1e-3, 1e-3}, std::pair{0.0, 1e-3}})
       if (!(z == 0 && y == 0)) mesh.coords.insert(mesh.coords.end(), {x, y, z});
-  mesh.hexes.push_back({3, 4, 5, 6, 2, 1, 7, 8});
+  mesh.elements(fem::ElementKind::Hex8).add({3, 4, 5, 6, 2, 1, 7, 8}, 0);
   return mesh;
 }
 
@@ -143,7 +143,7 @@ TEST(StitchConnection, RestOffsetTurnsWithTheTow) {
   s.sliding_force = 0.5;
   s.stiffness = 1000;
   drape::StitchToTowConnection conn("joint", {{0, 1, 2}}, s);
-  conn.initialise({&mesh, nullptr, mesh.coords.data(), mass.data(), 1e-5});
+  conn.initialise({&mesh, mesh.coords.data(), mass.data(), 1e-5});
   const double deg = M_PI / 180, th = 50 * deg, k[3] = {0, 0.6, 0.8};
   auto turned = [&](double shift_along) {  // Rodrigues: v cos + (k x v) sin + k (k.v)(1 - cos)
     std::vector<double> x(mesh.coords.size());
@@ -182,7 +182,7 @@ TEST(StitchConnection, ReleasedWhenItsAxisHexahedronIsEroded) {
   drape::StitchConnectionSettings s;
   s.stiffness = 1000;
   drape::StitchToTowConnection conn("joint", {{0, 1, 2}}, s);
-  conn.initialise({&mesh, nullptr, mesh.coords.data(), mass.data(), 1e-5});
+  conn.initialise({&mesh, mesh.coords.data(), mass.data(), 1e-5});
   std::vector<double> x = mesh.coords, f(x.size(), 0.0);
   x[0] += 0.1e-3;
   conn.add_forces(x.data(), nullptr, nullptr, 1e-5, f.data());
@@ -212,7 +212,7 @@ TEST(StitchConnection, ForcesAreTheGradientOfTheSpringEnergy) {
   drape::StitchConnectionSettings s;
   s.sliding_force = 1e6, s.transverse_force = 1e6, s.stiffness = 1000;
   drape::StitchToTowConnection conn("joint", {{0, 1, 2}, {a2, 2, 1}}, s);
-  conn.initialise({&mesh, nullptr, mesh.coords.data(), mass.data(), 1e-5});
+  conn.initialise({&mesh, mesh.coords.data(), mass.data(), 1e-5});
   ASSERT_EQ(conn.axis_hexahedra(), 1u);
   // A deformed state: every node moved by up to 0.3 mm, not a rigid motion.
   const std::size_t nd = mesh.coords.size();
@@ -263,17 +263,16 @@ TEST(StitchConnection, StitchPinsThePliesToEachOther) {
   model.parts.resize(model.mesh.part_names.size());
   model.materials.push_back(std::make_unique<fem::ElasticIsotropic>("tow", 1080, 1e9, 0.3));
   for (int p : fm.ply_parts)
-    model.parts[static_cast<std::size_t>(p)] = {fem::PartProperties::Kind::Solid, 0};
+    model.parts[static_cast<std::size_t>(p)] = {.material = 0};
   // A heavy yarn (100 x 76 dtex) lets the joints be stiff (their stiffness is capped by the stitch
   // node mass): they slide after ~0.1 um, well before the 20 um of pull.
   model.bar_laws.push_back(fem::BarForceLaw::linear("stitch", 2.0, true, 7.6e-4));
   for (int p : {fm.stitch_I_part, fm.stitch_Lambda_part, fm.stitch_leg_part}) {
-    model.parts[static_cast<std::size_t>(p)].kind = fem::PartProperties::Kind::Bar;
     model.parts[static_cast<std::size_t>(p)].bar_law = 0;
   }
   std::vector<int> ply_of_node(model.mesh.n_nodes(), -1);
-  for (std::size_t e = 0; e < model.mesh.hexes.size(); ++e)
-    for (auto nd : model.mesh.hexes[e])
+  for (std::size_t e = 0; e < model.mesh.n_elements(fem::ElementKind::Hex8); ++e)
+    for (auto nd : model.mesh.elements(fem::ElementKind::Hex8).nodes(e))
       ply_of_node[static_cast<std::size_t>(nd)] =
           fm.ply_of_tow[static_cast<std::size_t>(fm.tow_of_hex[e])];
   fem::FixedDofs hold;

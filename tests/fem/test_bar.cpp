@@ -31,11 +31,9 @@ BarRun drive_bar(double vx, bool tension_only, double travel) {
   fem::Model model;
   const int p = model.mesh.add_part("stitch");
   model.mesh.coords = {0, 0, 0, 0.01, 0, 0};
-  model.mesh.bars.push_back({0, 1});
-  model.mesh.bar_part.push_back(p);
+  model.mesh.elements(fem::ElementKind::Bar2).add({0, 1}, p);
   model.bar_laws.push_back(fem::BarForceLaw::linear("yarn", 100.0, tension_only, 1e-4));
   model.parts.resize(1);
-  model.parts[0].kind = fem::PartProperties::Kind::Bar;
   model.parts[0].bar_law = 0;
   model.fixed.push_back({"anchor", {0}, {true, true, true}});
   fem::PrescribedVelocity pv{"pull", {1}, {true, true, true}, {vx, 0, 0}, 0.0, 0.0};
@@ -44,7 +42,7 @@ BarRun drive_bar(double vx, bool tension_only, double travel) {
   fem::ExplicitSolver solver(model);
   while (std::abs(test::node_coord(solver, 1, 0) - 0.01) < travel) solver.step();
   solver.step();
-  const auto& b = solver.bar_blocks().at(0);
+  const auto& b = solver.blocks<fem::BarBlock>().at(0);
   return {b.force[0], solver.reaction_force({0}).x, solver.energy().internal};
 }
 
@@ -75,15 +73,14 @@ TEST(Bar, NonFiniteForceNamesTheBarAndWhere) {
   fem::Model model;
   const int p = model.mesh.add_part("stitch");
   model.mesh.coords = {0, 0, 0, 0.01, 0, 0, 0.02, 0.002, 0};
-  model.mesh.bars = {{0, 1}, {1, 2}};
-  model.mesh.bar_part = {p, p};
+  model.mesh.elements(fem::ElementKind::Bar2).add({0, 1}, p);
+  model.mesh.elements(fem::ElementKind::Bar2).add({1, 2}, p);
   model.bar_laws.push_back(fem::BarForceLaw::linear("yarn", 100.0, true, 1e-4));
   model.parts.resize(1);
-  model.parts[0].kind = fem::PartProperties::Kind::Bar;
   model.parts[0].bar_law = 0;
   model.time.end_time = 1;
   fem::ExplicitSolver solver(model);
-  fem::BarBlock b = solver.bar_blocks().at(0);
+  fem::BarBlock b = solver.blocks<fem::BarBlock>().at(0);
   ASSERT_EQ(b.n, 2u);
   std::vector<double> x = model.mesh.coords, f(x.size(), 0.0);
   x[6] = std::nan("");  // node 2 is lost: the second bar's force is not finite

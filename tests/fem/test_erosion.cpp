@@ -55,7 +55,7 @@ TEST(HexErosion, CrushedElementIsErodedAtTheStepRatio) {
   ASSERT_EQ(solver.erosions().size(), 1u)
       << "the crushed cube was not eroded by t = " << solver.time();
   const auto& ev = solver.erosions()[0];
-  EXPECT_EQ(ev.element, model.mesh.hex_user_id[0]);
+  EXPECT_EQ(ev.element, model.mesh.elements(fem::ElementKind::Hex8).user_id[0]);
   EXPECT_NEAR(ev.time, t_e, 2 * dt0) << "eroded when h_A / h = " << 1 - kV * ev.time / kH;
   EXPECT_LT(ev.step, kRatio * dt0);
   EXPECT_GT(std::abs(reaction_before), 0.1 * M * kH * kH) << "the base carried the crushing force";

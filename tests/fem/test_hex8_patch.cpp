@@ -4,6 +4,7 @@
 // Green-Lagrange strain E = (F^T F - I)/2 and stress S = C : E, to 1e-10 relative.
 #include <random>
 
+#include "fem/elements/hex8_block.hpp"
 #include "tests/test_support.hpp"
 
 using namespace ncfsim;
@@ -88,7 +89,7 @@ TEST(Hex8PatchTest, DistortedMeshReproducesHomogeneousDeformation) {
   double smax = 0;
   for (double s : Sv) smax = std::max(smax, std::abs(s));
 
-  const auto& b = solver.hex_blocks().at(0);
+  const auto& b = solver.blocks<fem::Hex8Block>().at(0);
   ASSERT_EQ(b.n, 8u);
   for (std::size_t e = 0; e < b.n; ++e)
     for (int c = 0; c < 6; ++c) {

@@ -68,12 +68,7 @@ std::vector<std::int32_t> select_nodes(const TableReader& owner, std::string_vie
     for (const auto& name : names) {
       const int p = mesh.find_part(name);
       if (p < 0) sel->fail("part", "no part named '" + name + "'");
-      for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
-        if (mesh.hex_part[e] == p)
-          for (auto node : mesh.hexes[e]) in_part[static_cast<std::size_t>(node)] = 1;
-      for (std::size_t e = 0; e < mesh.bars.size(); ++e)
-        if (mesh.bar_part[e] == p)
-          for (auto node : mesh.bars[e]) in_part[static_cast<std::size_t>(node)] = 1;
+      mesh.for_each_element_node(p, [&](std::int32_t node) { in_part[static_cast<std::size_t>(node)] = 1; });
     }
     for (std::size_t i = 0; i < n; ++i) keep[i] &= in_part[i];
   }
@@ -403,8 +398,7 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
         mesh.coords.push_back(a[static_cast<std::size_t>(k)] + s * (bnd[static_cast<std::size_t>(k)] - a[static_cast<std::size_t>(k)]));
     }
     for (int i = 0; i < n_div; ++i) {
-      mesh.bars.push_back({first + i, first + i + 1});
-      mesh.bar_part.push_back(p);
+      mesh.elements(fem::ElementKind::Bar2).add({first + i, first + i + 1}, p);
     }
   }
   struct FabricEntry {
@@ -509,7 +503,6 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
     auto& pp = ec.model.parts[static_cast<std::size_t>(p)];
     defined[static_cast<std::size_t>(p)] = 1;
     if (part_kind[name] == "solid") {
-      pp.kind = fem::PartProperties::Kind::Solid;
       const std::string mat = t.string("material");
       if (!materials.count(mat)) t.fail("material", "no [[material]] named '" + mat + "'");
       pp.material = materials[mat];
@@ -517,7 +510,6 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
       pp.hourglass_stiffness = t.number("hourglass_stiffness", 1.0, Range::closed(0, 10));
       pp.hourglass_viscosity = t.number("hourglass_viscosity", 0.05, Range::closed(0, 1));
     } else {
-      pp.kind = fem::PartProperties::Kind::Bar;
       const std::string law = t.string("bar_law");
       if (!bar_laws.count(law)) t.fail("bar_law", "no [[bar_law]] named '" + law + "'");
       pp.bar_law = bar_laws[law];
@@ -542,7 +534,6 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
                            "one hexahedron through the tow thickness)");
     for (std::size_t q = 0; q < fe.model.ply_parts.size(); ++q) {
       auto& pp = ec.model.parts[static_cast<std::size_t>(fe.model.ply_parts[q])];
-      pp.kind = fem::PartProperties::Kind::Solid;
       pp.material = tow;
       const double al = fe.angles[q] * M_PI / 180.0;
       pp.material_axes = {std::cos(al), -std::sin(al), 0, std::sin(al), std::cos(al), 0, 0, 0, 1};
@@ -553,7 +544,6 @@ EngineCase load_engine_case(const std::filesystem::path& file, const std::vector
     for (const auto& [p, law] : bar_parts) {
       if (p < 0) continue;
       auto& pp = ec.model.parts[static_cast<std::size_t>(p)];
-      pp.kind = fem::PartProperties::Kind::Bar;
       pp.bar_law = need(bar_laws, law, law == fe.law_I ? "stitch_law_I" : law == fe.law_Lambda ? "stitch_law_Lambda" : "stitch_law_legs");
       defined[static_cast<std::size_t>(p)] = 1;
     }

@@ -74,7 +74,7 @@ void write_figure_specs(const std::filesystem::path& dir, const EngineCase& ec) 
                         {"title", p.title}, {"follow_part", p.follow_part},
                         {"deformation_scale", p.deformation_scale}});
   if (ec.pictures.empty()) {
-    if (!ec.model.mesh.hexes.empty())
+    if (ec.model.mesh.n_elements(fem::ElementKind::Hex8) > 0)
       pictures.push_back({{"name", "final_von_mises"}, {"field", "von_mises_stress"}, {"camera", "iso"},
                           {"title", ec.name + ": von Mises stress, final state"}});
     pictures.push_back({{"name", "final_displacement"}, {"field", "displacement_magnitude"}, {"camera", "iso"},

@@ -11,7 +11,7 @@
 
 #include "drape/stitch_calibration.hpp"
 #include "drape/stitch_connection.hpp"
-#include "fem/element_fields.hpp"
+#include "fem/elements/element_fields.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/result_writers.hpp"
 #include "fem/solver.hpp"
@@ -60,12 +60,12 @@ fem::io::ResultMesh result_mesh(const fem::ExplicitSolver& s) {
   fem::io::ResultMesh m;
   m.points = s.model().mesh.coords;
   m.part_names = s.model().mesh.part_names;
-  for (const auto& b : s.hex_blocks())
+  for (const auto& b : s.blocks<fem::Hex8Block>())
     for (std::size_t e = 0; e < b.n; ++e) {
       for (int I = 0; I < 8; ++I) m.hex8.push_back(b.conn[static_cast<std::size_t>(I) * b.n + e]);
       m.hex_part.push_back(b.part);
     }
-  for (const auto& b : s.bar_blocks())
+  for (const auto& b : s.blocks<fem::BarBlock>())
     for (std::size_t e = 0; e < b.n; ++e) {
       m.bar2.push_back(b.conn[e]);
       m.bar2.push_back(b.conn[b.n + e]);
@@ -85,7 +85,7 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
   fr.displacement.resize(3 * nn);
   for (std::size_t d = 0; d < 3 * nn; ++d) fr.displacement[d] = X[d] - X0[d];
   fr.fields.push_back({"velocity", false, 3, std::vector<double>(Vv.data(), Vv.data() + 3 * nn)});
-  const std::size_t nh = s.n_hexes(), nb = s.n_bars();
+  const std::size_t nh = s.n_elements(fem::ElementKind::Hex8), nb = s.n_elements(fem::ElementKind::Bar2);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   fem::io::FrameField stress{"stress", true, 6, std::vector<double>(6 * (nh + nb), nan)};
   fem::io::FrameField vm{"von_mises_stress", true, 1, std::vector<double>(nh + nb, nan)};
@@ -93,12 +93,12 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
   fem::io::FrameField axial{"axial_force", true, 1, std::vector<double>(nh + nb, nan)};
   fem::io::FrameField bstrain{"axial_strain", true, 1, std::vector<double>(nh + nb, nan)};
   std::size_t off = 0;
-  for (const auto& b : s.hex_blocks()) {
+  for (const auto& b : s.blocks<fem::Hex8Block>()) {
     fem::hex8_output_fields(b, X.data(), stress.values.data() + 6 * off, vm.values.data() + off,
                             fibre.values.data() + 3 * off);
     off += b.n;
   }
-  for (const auto& b : s.bar_blocks()) {
+  for (const auto& b : s.blocks<fem::BarBlock>()) {
     for (std::size_t e = 0; e < b.n; ++e) {
       axial.values[off + e] = b.force[e];
       bstrain.values[off + e] = b.strain[e];
@@ -114,7 +114,7 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
     // 1 where a hexahedron was eroded (ParaView: threshold it away)
     fem::io::FrameField eroded{"eroded", true, 1, std::vector<double>(nh + nb, 0.0)};
     std::size_t o = 0;
-    for (const auto& b : s.hex_blocks()) {
+    for (const auto& b : s.blocks<fem::Hex8Block>()) {
       if (b.n_eroded)
         for (std::size_t e = 0; e < b.n; ++e) eroded.values[o + e] = b.eroded[e];
       o += b.n;
@@ -182,7 +182,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   const fem::Model& model = solver.model();
 
   log->info("mesh: {} nodes, {} hexahedra, {} bars, {} parts, {} tools", model.mesh.n_nodes(),
-            solver.n_hexes(), solver.n_bars(), model.mesh.part_names.size(), model.tools.size());
+            solver.n_elements(fem::ElementKind::Hex8), solver.n_elements(fem::ElementKind::Bar2), model.mesh.part_names.size(), model.tools.size());
   json fabrics = json::object();
   for (const auto& f : ec.fabric_summaries) {
     log->info("fabric {}: {} tows ({} dropped at the corners), tow thickness {:.4g} mm, {} stitch penetrations, "
@@ -207,7 +207,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   std::vector<std::size_t> joints_released_logged(ec.fabric_summaries.size(), 0);
   const auto& st = solver.controlling_element();
   log->info("stable step {:.4g} s (safety factor {}), controlled by {} {}", solver.time_step(),
-            model.time.safety_factor, st.is_bar ? "bar" : "hexahedron", st.element);
+            model.time.safety_factor, fem::element_noun(st.kind), st.element);
   json parts = json::object();
   for (const auto& pm : solver.part_masses()) {
     const double pct = pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0;
@@ -218,7 +218,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   const double est_cycles = model.time.end_time / solver.time_step();
   log->info("end time {:.4g} s: about {:.3g} cycles", model.time.end_time, est_cycles);
 
-  summary["elements"] = {{"hex8", solver.n_hexes()}, {"bar2", solver.n_bars()}};
+  summary["elements"] = {{"hex8", solver.n_elements(fem::ElementKind::Hex8)}, {"bar2", solver.n_elements(fem::ElementKind::Bar2)}};
   summary["nodes"] = model.mesh.n_nodes();
   summary["parts"] = parts;
   summary["end_time_s"] = model.time.end_time;
@@ -274,8 +274,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     auto X0 = solver.x0.view();
     for (const auto& sp : ec.shear_probes) {
       ProbeElements pe;
-      for (std::size_t k = 0; k < solver.hex_blocks().size(); ++k) {
-        const auto& b = solver.hex_blocks()[k];
+      for (std::size_t k = 0; k < solver.blocks<fem::Hex8Block>().size(); ++k) {
+        const auto& b = solver.blocks<fem::Hex8Block>()[k];
         if (b.part != sp.part_a && b.part != sp.part_b) continue;
         for (std::size_t e = 0; e < b.n; ++e) {
           double c[3] = {0, 0, 0};
@@ -300,7 +300,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     auto mean = [&](const std::vector<std::pair<std::size_t, std::size_t>>& set) {
       V3 s, first;
       for (const auto& [k, e] : set) {
-        const auto& b = solver.hex_blocks()[k];
+        const auto& b = solver.blocks<fem::Hex8Block>()[k];
         if (b.n_eroded && b.eroded[e]) continue;  // no longer part of the fabric
         double d[3];
         fem::hex8_fibre_direction(b, X.data(), e, d);
@@ -325,9 +325,10 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     for (const auto& bp : ec.bending) {
       BendingState bs;
       double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-      for (std::size_t e = 0; e < model.mesh.hexes.size(); ++e)
-        if (model.mesh.hex_part[e] == bp.part)
-          for (auto nd : model.mesh.hexes[e])
+      const auto& hexes = model.mesh.elements(fem::ElementKind::Hex8);
+      for (std::size_t e = 0; e < hexes.size(); ++e)
+        if (hexes.part[e] == bp.part)
+          for (auto nd : hexes.nodes(e))
             for (int r = 0; r < 3; ++r) {
               lo[r] = std::min(lo[r], X0[3 * static_cast<std::size_t>(nd) + static_cast<std::size_t>(r)]);
               hi[r] = std::max(hi[r], X0[3 * static_cast<std::size_t>(nd) + static_cast<std::size_t>(r)]);
@@ -662,7 +663,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
             en.time, en.kinetic, en.internal, en.stabilisation, en.hourglass, en.contact, en.friction, en.damping,
             en.external_work, 100 * err, 100 * tc.energy_balance_limit);
   const auto& tm = solver.timers();
-  const double elem_cycles = static_cast<double>(solver.cycle()) * static_cast<double>(solver.n_hexes() + solver.n_bars());
+  const double elem_cycles = static_cast<double>(solver.cycle()) * static_cast<double>(solver.n_elements(fem::ElementKind::Hex8) + solver.n_elements(fem::ElementKind::Bar2));
   log->info("{} cycles in {} | internal force {:.3g} s ({:.0f} ns per element-cycle), contact {:.3g} s, "
             "update {:.3g} s, output {:.3g} s",
             solver.cycle(), hms(summary["wall_seconds"].get<double>()), tm.internal_force,

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "fem/elements/element_step.hpp"
 #include "fem/material.hpp"
 
 namespace ncfsim::fem {
@@ -36,7 +37,7 @@ struct Hex8Block {
   std::vector<double> volume;          // [n] current volume
   std::vector<double> volume0;         // [n] reference volume
   std::vector<double> density;         // [n] density incl. mass scaling
-  std::vector<std::int32_t> mesh_hex;  // [n] index into Mesh::hexes (contact surfaces refer to it)
+  std::vector<std::int32_t> mesh_hex;  // [n] index into the mesh's hexahedron set
   std::vector<std::uint8_t> eroded;    // [n] 1: removed from the calculation (empty: none yet)
   std::size_t n_eroded = 0;
   double hourglass_stiffness = 1.0;    // scale of the physical stabilisation (1 = exact bending)
@@ -53,18 +54,6 @@ struct Hex8Block {
   // used) for an isotropic material.
   std::vector<double> step_modulus;  // [n] Pa
   std::vector<double> step_length0;  // [n] m
-};
-
-struct ElementEnergyIncrement {
-  double internal = 0;       // stress power incl. physical stabilisation
-  double stabilisation = 0;  // part of `internal` carried by the stabilisation
-  double hourglass = 0;      // viscous (non-physical) hourglass work
-};
-
-struct StableStep {
-  double dt = 1e300;
-  std::int64_t element = -1;  // user id of the controlling element
-  bool is_bar = false;
 };
 
 /// Sets up a block from reference coordinates: volumes, frames, hourglass moduli, density.
@@ -109,5 +98,16 @@ double hex8_erode(Hex8Block& b, std::size_t e);
 void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double dt, double* f,
                           ElementEnergyIncrement& energy, StableStep& step,
                           const double* x_ref = nullptr);
+
+// The block behind an element group (fem/elements/element_group.hpp), null for another kind.
+class ElementGroup;
+template <class Block>
+Block* block_of(ElementGroup& g);
+template <class Block>
+const Block* block_of(const ElementGroup& g);
+template <>
+Hex8Block* block_of<Hex8Block>(ElementGroup& g);
+template <>
+const Hex8Block* block_of<Hex8Block>(const ElementGroup& g);
 
 }  // namespace ncfsim::fem

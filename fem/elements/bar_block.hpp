@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "fem/hex8_block.hpp"
+#include "fem/elements/element_step.hpp"
 
 namespace ncfsim::fem {
 
@@ -59,5 +59,16 @@ void bar_initialise(BarBlock& b, const double* x_ref);
 void bar_lumped_mass(const BarBlock& b, double* mass);
 void bar_internal_forces(BarBlock& b, const double* x, double* f, ElementEnergyIncrement& energy,
                          StableStep& step);
+
+// The block behind an element group (fem/elements/element_group.hpp), null for another kind.
+class ElementGroup;
+template <class Block>
+Block* block_of(ElementGroup& g);
+template <class Block>
+const Block* block_of(const ElementGroup& g);
+template <>
+BarBlock* block_of<BarBlock>(ElementGroup& g);
+template <>
+const BarBlock* block_of<BarBlock>(const ElementGroup& g);
 
 }  // namespace ncfsim::fem

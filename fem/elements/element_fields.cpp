@@ -1,9 +1,9 @@
-#include "fem/element_fields.hpp"
+#include "fem/elements/element_fields.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "fem/hex8_basis.hpp"
+#include "fem/elements/hex8_basis.hpp"
 
 namespace ncfsim::fem {
 

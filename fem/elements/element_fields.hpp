@@ -3,8 +3,8 @@
 // stress and the convected fibre direction of hexahedra; axial force and strain of bars.
 #include <vector>
 
-#include "fem/bar_block.hpp"
-#include "fem/hex8_block.hpp"
+#include "fem/elements/bar_block.hpp"
+#include "fem/elements/hex8_block.hpp"
 
 namespace ncfsim::fem {
 

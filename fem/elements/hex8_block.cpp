@@ -1,7 +1,7 @@
 // GCC 12 reports false maybe-uninitialized warnings inside its own AVX-512 intrinsics (the
 // undefined pass-through operand of the masked sqrt) when it inlines std::experimental::simd.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include "fem/hex8_block.hpp"
+#include "fem/elements/hex8_block.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +11,8 @@
 #include <Eigen/Eigenvalues>
 
 #include "fem/errors.hpp"
-#include "fem/hex8_basis.hpp"
-#include "fem/simd_batch.hpp"
+#include "fem/elements/hex8_basis.hpp"
+#include "fem/elements/simd_batch.hpp"
 
 namespace ncfsim::fem {
 namespace stdx = std::experimental;
@@ -372,7 +372,7 @@ StableStep hex8_stable_step(const Hex8Block& b, const double* x) {
   hex8_element_steps(b, x, dt);
   StableStep s;
   for (std::size_t e = 0; e < b.n; ++e)
-    if (dt[e] < s.dt) s = {dt[e], b.user_id[e], false};
+    if (dt[e] < s.dt) s = {dt[e], b.user_id[e], ElementKind::Hex8};
   return s;
 }
 
@@ -771,7 +771,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
     }
     for (int j = 0; j < m; ++j)
       if (dtc[j] < step.dt && !(dead && dead[e0 + static_cast<std::size_t>(j)]))
-        step = {dtc[j], b.user_id[e0 + static_cast<std::size_t>(j)], false};
+        step = {dtc[j], b.user_id[e0 + static_cast<std::size_t>(j)], ElementKind::Hex8};
   }
   energy.internal += stdx::reduce(e_int) + stdx::reduce(e_stab);
   energy.stabilisation += stdx::reduce(e_stab);

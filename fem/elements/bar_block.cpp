@@ -1,7 +1,7 @@
 // GCC 12 reports false maybe-uninitialized warnings inside its own AVX-512 intrinsics (the
 // undefined pass-through operand of the masked sqrt) when it inlines std::experimental::simd.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include "fem/bar_block.hpp"
+#include "fem/elements/bar_block.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "fem/errors.hpp"
-#include "fem/simd_batch.hpp"
+#include "fem/elements/simd_batch.hpp"
 
 namespace ncfsim::fem {
 
@@ -156,7 +156,7 @@ void bar_internal_forces(BarBlock& b, const double* x, double* f, ElementEnergyI
       batch::store_a(sx + k, s * dx), batch::store_a(sy + k, s * dy), batch::store_a(sz + k, s * dz);
       if (stdx::any_of(load(dtc + e, cnt) < step.dt))  // rare: scan in element order
         for (int l = 0; l < cnt; ++l)
-          if (dtc[e + l] < step.dt) step = {dtc[e + l], b.user_id[e + l], true};
+          if (dtc[e + l] < step.dt) step = {dtc[e + l], b.user_id[e + l], ElementKind::Bar2};
     }
     for (int k = 0; k < m; ++k) {
       const std::size_t i = 3 * static_cast<std::size_t>(c0[e0 + k]), j = 3 * static_cast<std::size_t>(c1[e0 + k]);

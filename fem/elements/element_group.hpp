@@ -1,0 +1,106 @@
+#pragma once
+// One element group: the elements of one kind and one part, with their state as structure of
+// arrays and the kernels that advance it. The solver holds a list of groups and calls each once
+// per cycle phase (a virtual call per group, never per element; the kernels behind it batch the
+// elements in SIMD lanes). Groups are built by make_element_group (fem/elements/element_groups.cpp)
+// before the first cycle.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fem/elements/element_kind.hpp"
+#include "fem/elements/element_step.hpp"
+
+namespace ncfsim::fem {
+
+struct Model;
+struct ElementSet;
+
+/// Nodal state an element kernel reads in a cycle, [3*n_nodes] each.
+struct ElementCycleState {
+  const double* x = nullptr;      // positions x^n
+  const double* v = nullptr;      // velocities v^{n-1/2}
+  const double* x_ref = nullptr;  // reference positions
+  double dt = 0;                  // the step that moved the nodes to x^n
+};
+
+/// Name and size of one per-element output field (entity-major [n][components]).
+struct CellFieldSpec {
+  std::string name;
+  int components = 1;
+};
+
+class ElementGroup {
+ public:
+  virtual ~ElementGroup() = default;
+  virtual ElementKind kind() const = 0;
+  int part() const { return part_; }
+  std::size_t size() const { return n_; }
+  int nodes_per_element() const { return fem::nodes_per_element(kind()); }
+  /// Node I of element e is conn()[I * size() + e] ([nodes_per_element][n]).
+  const std::int32_t* conn() const { return conn_; }
+  std::int64_t user_id(std::size_t e) const { return user_id_[e]; }
+  /// Index of element e in its mesh element set.
+  std::int32_t set_index(std::size_t e) const { return set_index_[e]; }
+
+  /// Element nodal masses added into mass [3*n_nodes].
+  virtual void lumped_mass(double* mass) const = 0;
+  /// Physical mass and mass added by mass scaling, added into the two sums (kg).
+  virtual void add_part_mass(double& mass, double& added_mass) const = 0;
+  /// Adds mass where an element's step (times safety) is below target_dt, so that it reaches it.
+  virtual void scale_mass(const double* x, double target_dt, double safety) = 0;
+  /// Stable step of the group's controlling element at positions x.
+  virtual StableStep stable_step(const double* x) const = 0;
+  /// Internal forces subtracted from f [3*n_nodes]; energy increments accumulated, step lowered to
+  /// this group's controlling element.
+  virtual void internal_forces(const ElementCycleState& s, double* f,
+                               ElementEnergyIncrement& energy, StableStep& step) = 0;
+
+  // Erosion (kinds that can lose elements; the defaults are for those that cannot).
+  virtual bool can_erode() const { return false; }
+  /// Step of every element at x (1e300 for an eroded one) and, where asked, the smallest corner
+  /// Jacobian ratio of each (<= 0: folded over at a corner).
+  virtual void element_steps(const double* x, std::vector<double>& dt,
+                             std::vector<double>* corner_jacobian) const {
+    (void)x, (void)dt, (void)corner_jacobian;
+  }
+  /// Nodal forces f[nodes_per_element][3] element e exerts at x, v as it stands (not changed).
+  virtual void element_force(std::size_t e, const double* x, const double* v, double* f) const {
+    (void)e, (void)x, (void)v, (void)f;
+  }
+  /// Removes element e; returns the elastic energy it held, which leaves the model with it.
+  virtual double erode(std::size_t e) {
+    (void)e;
+    return 0;
+  }
+  virtual std::size_t n_eroded() const { return 0; }
+
+  /// Per-element output fields of this kind and their values for the group's elements:
+  /// out[k] points to [size()][components of field k] of cell_fields()[k].
+  virtual std::vector<CellFieldSpec> cell_fields() const = 0;
+  virtual void cell_values(const double* x, double* const* out) const = 0;
+
+ protected:
+  // Set by the group from its block's arrays (the block owns them).
+  int part_ = 0;
+  std::size_t n_ = 0;
+  const std::int32_t* conn_ = nullptr;
+  const std::int64_t* user_id_ = nullptr;
+  std::vector<std::int32_t> set_index_;
+};
+
+/// The elements `elements` (indices into `set`) of part `part`, as a group of the set's kind, set
+/// up at reference positions x_ref. Throws InputError naming the part when its properties do not
+/// fit the kind (no material, no bar law), NumericalError for a degenerate element.
+std::unique_ptr<ElementGroup> make_element_group(const Model& model, const ElementSet& set, int part,
+                                                 const std::vector<std::size_t>& elements,
+                                                 const double* x_ref);
+
+/// The block of kind Block behind a group, null when the group is of another kind.
+template <class Block>
+Block* block_of(ElementGroup& g);
+template <class Block>
+const Block* block_of(const ElementGroup& g);
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,54 @@
+#pragma once
+// The element kinds the engine knows, with what the rest of the code may ask of a kind without
+// naming it: nodes per element, names for messages and output, and the faces that bound a solid
+// element (contact surfaces are made of them). A new kind adds an enumerator here, a row in each
+// table below and a group in fem/elements/ (docs/architecture-elements.md).
+#include <array>
+#include <cstdint>
+#include <span>
+
+namespace ncfsim::fem {
+
+/// Kinds in the order the mesh keeps its element sets and the solver its groups (renumbering and
+/// the order in which element forces are summed depend on it: append new kinds at the end).
+enum class ElementKind : std::uint8_t { Hex8, Bar2 };
+constexpr std::array<ElementKind, 2> kElementKinds{ElementKind::Hex8, ElementKind::Bar2};
+constexpr int kMaxNodesPerElement = 8;
+
+constexpr int nodes_per_element(ElementKind k) {
+  constexpr int n[] = {8, 2};
+  return n[static_cast<int>(k)];
+}
+/// Noun for messages ("hexahedron 12 at ...").
+constexpr const char* element_noun(ElementKind k) {
+  constexpr const char* n[] = {"hexahedron", "bar"};
+  return n[static_cast<int>(k)];
+}
+/// Short name for output and summaries ("hex8").
+constexpr const char* element_kind_name(ElementKind k) {
+  constexpr const char* n[] = {"hex8", "bar2"};
+  return n[static_cast<int>(k)];
+}
+
+/// A two-node element must join two different nodes (checked by Mesh::validate).
+constexpr bool element_needs_distinct_nodes(ElementKind k) { return nodes_per_element(k) == 2; }
+
+/// A quadrilateral face of a solid element: corners (local node numbers) counter-clockwise seen
+/// from outside, and the face opposite it (its distance is the element's thickness behind the face).
+struct ElementFace {
+  std::array<int, 4> corner;
+  int opposite;
+};
+/// Faces of a solid kind (VTK hexahedron order); empty for a kind that bounds no volume.
+constexpr std::array<ElementFace, 6> kHex8Faces{{{{0, 3, 2, 1}, 1},
+                                                 {{4, 5, 6, 7}, 0},
+                                                 {{0, 1, 5, 4}, 4},
+                                                 {{1, 2, 6, 5}, 5},
+                                                 {{2, 3, 7, 6}, 2},
+                                                 {{3, 0, 4, 7}, 3}}};
+inline std::span<const ElementFace> element_faces(ElementKind k) {
+  if (k == ElementKind::Hex8) return kHex8Faces;
+  return {};
+}
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,103 @@
+// The hexahedron group: fem/elements/hex8_block.hpp's kernels behind the ElementGroup interface.
+#include <cmath>
+
+#include "fem/elements/element_fields.hpp"
+#include "fem/elements/element_group.hpp"
+#include "fem/elements/hex8_block.hpp"
+#include "fem/errors.hpp"
+#include "fem/mesh.hpp"
+#include "fem/model.hpp"
+
+namespace ncfsim::fem {
+
+namespace {
+
+class Hex8Group final : public ElementGroup {
+ public:
+  Hex8Block block;
+
+  void bind() {
+    part_ = block.part, n_ = block.n, conn_ = block.conn.data(), user_id_ = block.user_id.data();
+    set_index_ = block.mesh_hex;
+  }
+  ElementKind kind() const override { return ElementKind::Hex8; }
+  void lumped_mass(double* mass) const override { hex8_lumped_mass(block, mass); }
+  void add_part_mass(double& mass, double& added_mass) const override {
+    const double rho = block.material->density();
+    for (std::size_t e = 0; e < block.n; ++e) {
+      mass += rho * block.volume[e];
+      added_mass += (block.density[e] - rho) * block.volume[e];
+    }
+  }
+  void scale_mass(const double* x, double target, double sf) override {
+    std::vector<double> dt;
+    hex8_element_steps(block, x, dt);
+    for (std::size_t e = 0; e < block.n; ++e)
+      if (sf * dt[e] < target) block.density[e] *= std::pow(target / (sf * dt[e]), 2);
+  }
+  StableStep stable_step(const double* x) const override { return hex8_stable_step(block, x); }
+  void internal_forces(const ElementCycleState& s, double* f, ElementEnergyIncrement& energy,
+                       StableStep& step) override {
+    hex8_internal_forces(block, s.x, s.v, s.dt, f, energy, step, s.x_ref);
+  }
+  bool can_erode() const override { return true; }
+  void element_steps(const double* x, std::vector<double>& dt,
+                     std::vector<double>* corner_jacobian) const override {
+    hex8_element_steps(block, x, dt, corner_jacobian);
+  }
+  void element_force(std::size_t e, const double* x, const double* v, double* f) const override {
+    hex8_element_force(block, e, x, v, f);
+  }
+  double erode(std::size_t e) override { return hex8_erode(block, e); }
+  std::size_t n_eroded() const override { return block.n_eroded; }
+  std::vector<CellFieldSpec> cell_fields() const override {
+    return {{"stress", 6}, {"von_mises_stress", 1}, {"fibre_direction", 3}, {"eroded", 1}};
+  }
+  void cell_values(const double* x, double* const* out) const override {
+    hex8_output_fields(block, x, out[0], out[1], out[2]);
+    for (std::size_t e = 0; e < block.n; ++e) out[3][e] = block.n_eroded ? block.eroded[e] : 0.0;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<ElementGroup> make_hex8_group(const Model& model, const ElementSet& set, int part,
+                                              const std::vector<std::size_t>& elements,
+                                              const double* x_ref) {
+  const PartProperties& pp = model.parts[static_cast<std::size_t>(part)];
+  if (pp.material < 0 || static_cast<std::size_t>(pp.material) >= model.materials.size())
+    throw InputError("", "part." + model.mesh.part_names[static_cast<std::size_t>(part)] + ".material",
+                     "no such material");
+  auto g = std::make_unique<Hex8Group>();
+  Hex8Block& b = g->block;
+  b.part = part;
+  b.material = model.materials[static_cast<std::size_t>(pp.material)].get();
+  b.n = elements.size();
+  b.conn.resize(8 * b.n);
+  b.user_id.resize(b.n);
+  b.mesh_hex.resize(b.n);
+  for (std::size_t j = 0; j < b.n; ++j) {
+    const auto nodes = set.nodes(elements[j]);
+    for (std::size_t I = 0; I < 8; ++I) b.conn[I * b.n + j] = nodes[I];
+    b.user_id[j] = set.user_id[elements[j]];
+    b.mesh_hex[j] = static_cast<std::int32_t>(elements[j]);
+  }
+  b.hourglass_stiffness = pp.hourglass_stiffness;
+  b.hourglass_viscosity = pp.hourglass_viscosity;
+  hex8_initialise(b, x_ref, pp.material_axes);
+  g->bind();
+  return g;
+}
+
+template <>
+Hex8Block* block_of<Hex8Block>(ElementGroup& g) {
+  auto* h = dynamic_cast<Hex8Group*>(&g);
+  return h ? &h->block : nullptr;
+}
+template <>
+const Hex8Block* block_of<Hex8Block>(const ElementGroup& g) {
+  const auto* h = dynamic_cast<const Hex8Group*>(&g);
+  return h ? &h->block : nullptr;
+}
+
+}  // namespace ncfsim::fem
