@@ -39,7 +39,8 @@ int read_int(const TableReader& t, std::string_view key, int fallback) {
   return static_cast<int>(t.integer(key, fallback, INT_MIN, INT_MAX));
 }
 
-// The fabric's own keys. Their ranges are checked once, by drape::validate (drape/fabric.cpp).
+// The fabric's own keys. Their ranges are checked once, by drape::validate (drape/fabric.cpp):
+// on the keys as given here, on the spec as meshed (the resolution's divisions) by generate_blanket.
 FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution) {
   FabricSpec f;
   if (fb.has("ply_angles_deg")) f.ply_angles_deg = fb.numbers("ply_angles_deg", {});
@@ -56,8 +57,7 @@ FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution
   f.elements_across_tow = read_int(fb, "elements_across_tow", 2);
   f.elements_through_thickness = read_int(fb, "elements_through_thickness", 1);
   f.element_length = fb.number("element_length", 0.0, {});
-  validate(f, fb.file().string(), fb.path());  // the keys as given
-  if (resolution == "default") return f;
+  validate(f, fb.file().string(), fb.path());
   if (resolution == "coarse") {
     f.elements_across_tow = std::max(1, f.elements_across_tow / 2);
     f.element_length = 2 * (f.element_length > 0 ? f.element_length : f.tow_pitch());
@@ -65,7 +65,6 @@ FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution
     f.elements_across_tow *= 2;
     f.element_length = 0.5 * (f.element_length > 0 ? f.element_length : f.tow_pitch());
   }
-  validate(f, fb.file().string(), fb.path());  // the resolution's divisions (fine: twice across a tow)
   return f;
 }
 
@@ -96,12 +95,20 @@ FabricEntry read_fabric(fem::CaseReadContext& ctx, const TableReader& fb) {
   read_stitch_laws(fb, f, fe);
   fe.angles = f.ply_angles_deg;
   fe.elements_through_thickness = f.elements_through_thickness;
-  if (!(bl.size[0] >= f.tow_pitch() * (1 - 1e-9) && bl.size[1] >= f.tow_pitch() * (1 - 1e-9)))
-    fb.fail("size", "the blanket must be at least one tow pitch (" + std::to_string(f.tow_pitch()) + " m) long and wide");
   if (fe.name.empty() || fe.name.find_first_of(" ./\\") != std::string::npos)
     fb.fail("name", "must be a non-empty name without spaces, dots or slashes (it prefixes the part names)");
   fem::Mesh& mesh = ctx.model.mesh;
-  fe.model = generate_blanket(mesh, f, bl, ctx.file, fe.name + "_");
+  try {
+    fe.model = generate_blanket(mesh, f, bl, ctx.file, fe.name + "_", fe.path);
+  } catch (const InputError& e) {
+    // The value checked is the one meshed: say where it came from.
+    if (e.key() != fe.path + ".elements_across_tow" || ctx.resolution == "default") throw;
+    throw InputError(e.file(), e.key(),
+                     "value " + e.value() + " (mesh.resolution = " + ctx.resolution + " of " +
+                         std::to_string(fb.integer("elements_across_tow", 2, INT_MIN, INT_MAX)) +
+                         ") out of range, allowed " + e.allowed(),
+                     e.value(), e.allowed());
+  }
   auto generated = [&](int p, fem::PartKind kind) {
     const std::string& part = mesh.part_names[static_cast<std::size_t>(p)];
     ctx.part_kind[part] = kind;

@@ -19,20 +19,19 @@ std::array<bool, 3> read_dofs(const TableReader& t, std::string_view key, std::a
   return d;
 }
 
-void read_fixed(CaseReadContext& ctx, const TableReader& t) {
-  FixedDofs fx;
-  fx.name = t.string("name");
-  fx.nodes = select_nodes(ctx, t, "nodes");
-  fx.dofs = read_dofs(t, "dofs", {true, true, true});
-  ctx.model.fixed.push_back(std::move(fx));
+// The name, nodes and dofs of a constraint set (FixedDofs, PrescribedVelocity).
+template <class Set>
+Set read_constraint_set(const CaseReadContext& ctx, const TableReader& t) {
+  Set set;
+  set.name = t.string("name");
+  set.nodes = select_nodes(ctx, t, "nodes");
+  set.dofs = read_dofs(t, "dofs", {true, true, true});
+  return set;
 }
 
 void read_velocity(CaseReadContext& ctx, const TableReader& t) {
-  PrescribedVelocity pv;
-  pv.name = t.string("name");
-  pv.nodes = select_nodes(ctx, t, "nodes");
+  auto pv = read_constraint_set<PrescribedVelocity>(ctx, t);
   pv.velocity = to_v3(t.vec3("velocity"));
-  pv.dofs = read_dofs(t, "dofs", {true, true, true});
   pv.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
   pv.start_time = t.number("start_time", 0.0, Range::non_negative());
   ctx.model.velocities.push_back(std::move(pv));
@@ -63,7 +62,7 @@ void read_picture_frame(CaseReadContext& ctx, const TableReader& t) {
 void read_boundary(CaseReadContext& ctx) {
   const auto bc = ctx.root.table("boundary");
   if (!bc) return;
-  for (const auto& t : bc->tables("fixed")) read_fixed(ctx, t);
+  for (const auto& t : bc->tables("fixed")) ctx.model.fixed.push_back(read_constraint_set<FixedDofs>(ctx, t));
   for (const auto& t : bc->tables("velocity")) read_velocity(ctx, t);
   for (const auto& t : bc->tables("picture_frame")) read_picture_frame(ctx, t);
 }

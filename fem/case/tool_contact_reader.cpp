@@ -77,12 +77,18 @@ void read_tool(CaseReadContext& ctx, const TableReader& t) {
 
 // The values of [[contact]] are range-checked once, by fem::validate (fem/contact/contact_config),
 // with their case-file keys (key_path): here they are only read (a number, finite).
-std::unique_ptr<ContactAlgorithm> read_penalty_contact(const CaseReadContext& ctx, const TableReader& t,
-                                                       const std::string& name) {
-  PenaltyContactConfig c;
+template <class Config>
+Config contact_config(const CaseReadContext& ctx, const TableReader& t, const std::string& name) {
+  Config c;
   c.name = name;
   c.source_file = ctx.file;
   c.key_path = t.path();
+  return c;
+}
+
+std::unique_ptr<ContactAlgorithm> read_penalty_contact(const CaseReadContext& ctx, const TableReader& t,
+                                                       const std::string& name) {
+  auto c = contact_config<PenaltyContactConfig>(ctx, t, name);
   c.penalty_scale = t.number("penalty_scale", c.penalty_scale, {});
   c.thickness = t.number("thickness", 0.0, {});
   c.search_margin = t.number("search_margin", 0.0, {});
@@ -114,10 +120,7 @@ std::unique_ptr<ContactAlgorithm> read_penalty_contact(const CaseReadContext& ct
 
 std::unique_ptr<ContactAlgorithm> read_tied_contact(const CaseReadContext& ctx, const TableReader& t,
                                                     const std::string& name) {
-  TiedContactConfig c;
-  c.name = name;
-  c.source_file = ctx.file;
-  c.key_path = t.path();
+  auto c = contact_config<TiedContactConfig>(ctx, t, name);
   c.slave = {name + "_slave", part_indices(t, "slave_parts", ctx.model.mesh)};
   c.master = {name + "_master", part_indices(t, "master_parts", ctx.model.mesh)};
   c.penalty_scale = t.number("penalty_scale", c.penalty_scale, {});
