@@ -3,6 +3,7 @@
 #include "workflow/case/engine_case.hpp"
 
 #include "drape/case/drape_case.hpp"
+#include "fem/case/case_context.hpp"
 #include "fem/case/fem_case.hpp"
 #include "fem/errors.hpp"
 

@@ -8,8 +8,11 @@
 #include <vector>
 
 #include "drape/probe_specs.hpp"
-#include "fem/case/case_context.hpp"
 #include "fem/model.hpp"
+
+namespace ncfsim::fem {
+class CaseTypeRegistry;  // fem/case/case_context.hpp
+}
 
 namespace ncfsim::workflow {
 
