@@ -24,35 +24,36 @@ bool integer_multiple(double v, double unit) {
 }  // namespace
 
 void validate(const FabricSpec& f, const std::string& file, const std::string& prefix) {
-  auto fail = [&](const std::string& key, const std::string& msg) {
-    throw InputError(file, prefix.empty() ? key : prefix + "." + key, msg);
-  };
+  auto key = [&](const std::string& k) { return prefix.empty() ? k : prefix + "." + k; };
+  auto fail = [&](const std::string& k, const std::string& msg) { throw InputError(file, key(k), msg); };
+  auto check = [&](const std::string& k, double v, const Range& r) { check_range(file, key(k), v, r); };
+  // The only range checks of these [[mesh.fabric]] keys (the case reader, drape/case, reads them).
   if (f.ply_angles_deg.empty()) fail("ply_angles_deg", "needs at least one ply");
-  for (double a : f.ply_angles_deg)
-    if (!(a >= -90 && a <= 90)) fail("ply_angles_deg", "angles must be in [-90, 90] degrees");
-  if (!(f.tow_width > 0 && f.tow_width < 0.05)) fail("tow_width", "must be in (0, 0.05) m");
-  if (!(f.tow_gap > 0 && f.tow_gap < f.tow_width))
-    fail("tow_gap", "must be > 0 (tows must not touch initially) and smaller than the tow width");
-  if (!(f.areal_weight > 0 && f.areal_weight < 5)) fail("areal_weight", "must be in (0, 5) kg/m^2 per ply");
-  if (!(f.fibre_density > 0)) fail("fibre_density", "must be > 0");
-  if (!(f.tow_fibre_volume_fraction > 0 && f.tow_fibre_volume_fraction <= 0.9069))
-    fail("tow_fibre_volume_fraction", "must be in (0, 0.9069] (hexagonal packing limit)");
+  for (std::size_t i = 0; i < f.ply_angles_deg.size(); ++i)
+    if (!Range::closed(-90, 90).contains(f.ply_angles_deg[i]))
+      throw InputError::out_of_range(file, key("ply_angles_deg"), f.ply_angles_deg[i], Range::closed(-90, 90),
+                                     static_cast<long>(i));
+  check("tow_width", f.tow_width, Range::open(0, 0.05));
+  check("tow_gap", f.tow_gap, Range::positive());
+  if (!(f.tow_gap < f.tow_width))
+    fail("tow_gap", "must be smaller than the tow width (tows must not touch initially, gap > 0)");
+  check("areal_weight", f.areal_weight, Range::open(0, 5));
+  check("fibre_density", f.fibre_density, Range::positive());
+  check("tow_fibre_volume_fraction", f.tow_fibre_volume_fraction, Range::open_closed(0, 0.9069));
   const double t = f.tow_thickness();
   if (!(t < f.tow_width))
     fail("areal_weight", "gives a tow thicker (" + std::to_string(t * 1e3) + " mm) than wide: check areal weight, "
                          "fibre density and volume fraction");
-  if (f.elements_across_tow < 1 || f.elements_across_tow > 16) fail("elements_across_tow", "must be in [1, 16]");
-  if (f.elements_through_thickness < 1 || f.elements_through_thickness > 8)
-    fail("elements_through_thickness", "must be in [1, 8]");
-  if (f.element_length < 0) fail("element_length", "must be >= 0 (0: one tow pitch)");
+  check("elements_across_tow", f.elements_across_tow, Range::closed(1, 16));
+  check("elements_through_thickness", f.elements_through_thickness, Range::closed(1, 8));
+  check("element_length", f.element_length, Range::non_negative());
+  check("stitch_direction_deg", f.stitch_direction_deg, Range::closed(-90, 90));
+  check("stitch_gauge", f.stitch_gauge, Range::non_negative());   // 0: derived from the tow pitch
+  check("stitch_length", f.stitch_length, Range::non_negative());  // 0: equal to the gauge
   if (f.stitch != StitchPattern::None) {
-    if (f.stitch_gauge < 0) fail("stitch_gauge", "must be >= 0 (0: derived from the tow pitch)");
-    if (f.stitch_length < 0) fail("stitch_length", "must be >= 0 (0: equal to the gauge)");
     // Penetration points must fall into the gaps of every ply: along x and y their spacing must be
     // a whole number of tow pitches projected on the axes, p / |sin a| and p / |cos a|.
     const double p = f.tow_pitch();
-    if (!(f.stitch_direction_deg >= -90 && f.stitch_direction_deg <= 90))
-      fail("stitch_direction_deg", "must be in [-90, 90] degrees");
     for (double a : f.ply_angles_deg) {
       const double ar = (a - f.stitch_direction_deg) * M_PI / 180.0;  // tow angle to the wales
       const double sx = std::abs(std::sin(ar)), cy = std::abs(std::cos(ar));

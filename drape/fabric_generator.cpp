@@ -32,13 +32,16 @@ bool clip_line(const std::array<double, 2>& p0, const std::array<double, 2>& a, 
 }  // namespace
 
 FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl, const std::string& file,
-                             const std::string& prefix) {
-  validate(f, file, prefix.empty() ? "fabric" : prefix);
+                             const std::string& prefix, const std::string& key_path) {
+  // The spec as meshed (a case's resolution scales its divisions); the keys are checked here once.
+  validate(f, file, !key_path.empty() ? key_path : prefix.empty() ? "fabric" : prefix);
+  const std::string size_key = key_path.empty() ? prefix + "size" : key_path + ".size";
   const double Lx = bl.size[0], Ly = bl.size[1];
   const double p = f.tow_pitch(), w = f.tow_width, t = f.tow_thickness();
   const double s = f.penetration_spacing(), g = f.gauge();
   if (!(Lx >= p * (1 - 1e-9) && Ly >= p * (1 - 1e-9)))
-    throw InputError(file, prefix + "size", "the blanket must be at least one tow pitch long and wide");
+    throw InputError(file, size_key,
+                     "the blanket must be at least one tow pitch (" + std::to_string(p) + " m) long and wide");
   FabricModel fm;
   // Per tow node: its next node along the tow, same face (the connections' tow axis).
   std::vector<std::int32_t> axis_neighbour;
@@ -175,7 +178,7 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       }
       ++fm.n_penetrations;
     }
-  if (fm.n_penetrations == 0) throw InputError(file, prefix + "size", "the blanket holds no stitch penetration");
+  if (fm.n_penetrations == 0) throw InputError(file, size_key, "the blanket holds no stitch penetration");
   fm.stitch_I_part = mesh.add_part(prefix + "stitch_I");
   fm.stitch_leg_part = mesh.add_part(prefix + "stitch_legs");
   const bool tricot = f.stitch == StitchPattern::Tricot;

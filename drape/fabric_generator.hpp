@@ -50,8 +50,10 @@ struct FabricModel {
 
 /// Appends the blanket to `mesh` (parts "<prefix>ply<k>", "<prefix>stitch_I", "<prefix>stitch_Lambda",
 /// "<prefix>stitch_legs"). Tows shorter than two elements at the corners are dropped (counted).
-/// Throws InputError for an inconsistent fabric or a blanket smaller than one tow pitch.
+/// Throws InputError for an inconsistent fabric or a blanket smaller than one tow pitch, naming
+/// `key_path` + ".<key>" (the case file's table, "mesh.fabric[0]"; empty: "<prefix>" + key).
 FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& fabric, const BlanketSpec& blanket,
-                             const std::string& file = "", const std::string& prefix = "");
+                             const std::string& file = "", const std::string& prefix = "",
+                             const std::string& key_path = "");
 
 }  // namespace ncfsim::drape

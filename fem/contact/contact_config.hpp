@@ -4,7 +4,9 @@
 // to PenaltyContact / TiedContact. Units SI. Parts are named by their index in Mesh::part_names;
 // the mesh-dependent checks (part exists, holds hexahedra, parts not in two groups) happen in
 // initialise(), before the first cycle. Every check throws InputError(source_file, key, message)
-// with key "contact.<name>.<field>".
+// naming the case-file key (key_path + ".<field>", e.g. "contact[0].pair[1].friction") or, for a
+// config built in code (key_path empty), "contact.<name>.<field>". These are the only range checks
+// of the [[contact]] keys: the case reader (fem/case) reads the values and leaves them to validate().
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -23,7 +25,7 @@ struct ContactGroup {
 struct ContactPair {
   int first = 0;        // index into PenaltyContactConfig::groups; resultant is the force on it
   int second = 0;       // index into PenaltyContactConfig::groups
-  double friction = 0;  // Coulomb coefficient mu, >= 0 (0: frictionless)
+  double friction = 0;  // Coulomb coefficient mu, [0, 10] (0: frictionless)
 };
 
 /// Node-to-segment penalty contact between deformable surfaces with Coulomb friction.
@@ -54,6 +56,7 @@ struct PenaltyContactConfig {
   /// from the other side (a back face, or passed through) and gets no force, (0, 1].
   double max_penetration = 0.5;
   std::string source_file;  // for messages only (the case file), may be empty
+  std::string key_path;     // for messages only: the case-file table ("contact[0]"), may be empty
 };
 
 /// Nodes of the slave surface tied to the nearest master segment at t = 0 (within
@@ -75,6 +78,7 @@ struct TiedContactConfig {
   double normal_strength = 0;  // Pa, >= 0; 0: no failure in tension
   double shear_strength = 0;   // Pa, >= 0; 0: no failure in shear
   std::string source_file;     // for messages only, may be empty
+  std::string key_path;        // for messages only: the case-file table ("contact[1]"), may be empty
 };
 
 /// Range checks independent of the mesh; throw InputError naming the key, value and range.

@@ -1,13 +1,18 @@
 #pragma once
 // A case for the explicit engine, read from TOML: mesh (structured blocks and bar lines), materials,
 // bar laws, parts, constraints, loads, rigid tools, time controls, output, figures.
-// The keys are documented in docs/case-file.md; every value is range-checked here, before any run.
+// The keys are documented in docs/case-file.md; every value is range-checked before any run, once,
+// by the module that owns its section (fem/case, drape/case; docs/architecture-cases.md).
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "drape/probe_specs.hpp"
 #include "fem/model.hpp"
+
+namespace ncfsim::fem {
+class CaseTypeRegistry;  // fem/case/case_context.hpp
+}
 
 namespace ncfsim::workflow {
 
@@ -114,6 +119,9 @@ struct EngineCase {
   std::vector<SummaryMean> means;
   std::vector<double> frame_fabric_length;  // per picture frame: side of the fabric for normalising
 };
+
+/// The material types an engine case knows: fem's, then drape's (tow_biphase).
+fem::CaseTypeRegistry engine_case_types();
 
 /// Reads and checks a case (throws InputError naming file and key). `overrides` are --set items.
 EngineCase load_engine_case(const std::filesystem::path& file, const std::vector<std::string>& overrides);

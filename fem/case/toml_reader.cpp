@@ -1,4 +1,4 @@
-#include "workflow/case/toml_reader.hpp"
+#include "fem/case/toml_reader.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "fem/errors.hpp"
 
-namespace ncfsim::workflow {
+namespace ncfsim::fem {
 
 namespace {
 
@@ -96,29 +96,6 @@ toml::table* ensure_table(toml::table& root, const std::vector<std::string>& par
 
 }  // namespace
 
-bool Range::contains(double v) const {
-  if (!std::isfinite(v)) return false;
-  if (lo_open ? !(v > lo) : !(v >= lo)) return false;
-  if (hi_open ? !(v < hi) : !(v <= hi)) return false;
-  return true;
-}
-
-std::string Range::describe() const {
-  std::ostringstream os;
-  os.precision(6);
-  const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
-  if (has_lo && has_hi) {
-    os << (lo_open ? "(" : "[") << lo << ", " << hi << (hi_open ? ")" : "]");
-  } else if (has_lo) {
-    os << (lo_open ? "> " : ">= ") << lo;
-  } else if (has_hi) {
-    os << (hi_open ? "< " : "<= ") << hi;
-  } else {
-    os << "finite";
-  }
-  return os.str();
-}
-
 CaseDocument CaseDocument::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   CaseDocument doc;
   doc.file_ = file;
@@ -205,11 +182,7 @@ double TableReader::as_number(std::string_view key, const toml::node& n) const {
 
 double TableReader::number(std::string_view key, Range range) const {
   const double v = as_number(key, require(key));
-  if (!range.contains(v)) {
-    std::ostringstream os;
-    os << "value " << v << " out of range, allowed " << range.describe();
-    fail(key, os.str());
-  }
+  if (!range.contains(v)) throw InputError::out_of_range(file().string(), key_path(key), v, range);
   return v;
 }
 
@@ -221,9 +194,12 @@ std::int64_t TableReader::integer(std::string_view key, std::int64_t lo, std::in
   const toml::node& n = require(key);
   const auto v = n.value_exact<std::int64_t>();
   if (!v) fail(key, "must be an integer, got " + type_name(n));
-  if (*v < lo || *v > hi)
-    fail(key, "value " + std::to_string(*v) + " out of range, allowed [" + std::to_string(lo) + ", " +
-                  std::to_string(hi) + "]");
+  if (*v < lo || *v > hi) {
+    const std::string allowed = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    throw InputError(file().string(), key_path(key),
+                     "value " + std::to_string(*v) + " out of range, allowed " + allowed,
+                     std::to_string(*v), allowed);
+  }
   return *v;
 }
 
@@ -254,11 +230,8 @@ std::string TableReader::string(std::string_view key, const std::string& fallbac
 std::string TableReader::choice(std::string_view key, const std::vector<std::string>& choices,
                                 const std::string& fallback) const {
   const std::string v = string(key, fallback);
-  if (std::find(choices.begin(), choices.end(), v) == choices.end()) {
-    std::string all;
-    for (const auto& c : choices) all += (all.empty() ? "" : ", ") + ("'" + c + "'");
-    fail(key, "'" + v + "' is not allowed; one of " + all);
-  }
+  if (std::find(choices.begin(), choices.end(), v) == choices.end())
+    throw InputError::not_one_of(file().string(), key_path(key), v, choices);
   return v;
 }
 
@@ -270,11 +243,8 @@ std::vector<double> TableReader::numbers(std::string_view key, Range range, std:
   std::vector<double> out;
   for (std::size_t i = 0; i < a->size(); ++i) {
     const double v = as_number(key, *a->get(i));
-    if (!range.contains(v)) {
-      std::ostringstream os;
-      os << "entry " << i << " = " << v << " out of range, allowed " << range.describe();
-      fail(key, os.str());
-    }
+    if (!range.contains(v))
+      throw InputError::out_of_range(file().string(), key_path(key), v, range, static_cast<long>(i));
     out.push_back(v);
   }
   return out;
@@ -328,4 +298,10 @@ std::vector<TableReader> TableReader::tables(std::string_view key) const {
   return out;
 }
 
-}  // namespace ncfsim::workflow
+std::vector<std::string> TableReader::keys() const {
+  std::vector<std::string> out;
+  for (const auto& [k, v] : table_) out.emplace_back(k.str());
+  return out;
+}
+
+}  // namespace ncfsim::fem

@@ -1,7 +1,8 @@
 #pragma once
 // Strict, typed reading of a TOML case file: every key read is recorded, so that after a case is
 // built any key nobody read is reported as unknown (with the closest known key as a hint). Every
-// error is an InputError naming the file, the full key path and the allowed range.
+// error is an InputError naming the file, the full key path, the value and the allowed range.
+// Used by every module's case reader (fem/case, drape/case, workflow/case).
 #include <array>
 #include <filesystem>
 #include <limits>
@@ -12,20 +13,11 @@
 
 #include <toml++/toml.h>
 
-namespace ncfsim::workflow {
+#include "fem/errors.hpp"
 
-/// Allowed interval of a number; bounds are inclusive unless marked open.
-struct Range {
-  double lo = -std::numeric_limits<double>::infinity();
-  double hi = std::numeric_limits<double>::infinity();
-  bool lo_open = false, hi_open = false;
-  static Range positive() { return {0, std::numeric_limits<double>::infinity(), true, false}; }
-  static Range non_negative() { return {0, std::numeric_limits<double>::infinity(), false, false}; }
-  static Range closed(double a, double b) { return {a, b, false, false}; }
-  static Range open_closed(double a, double b) { return {a, b, true, false}; }
-  bool contains(double v) const;
-  std::string describe() const;
-};
+namespace ncfsim::fem {
+
+// Range (the allowed interval of a number) is ncfsim::Range, in fem/errors.hpp with InputError.
 
 /// The parsed document: root table, file name and the set of keys read so far.
 class CaseDocument {
@@ -50,6 +42,7 @@ class TableReader {
   TableReader(CaseDocument& doc, const toml::table& table, std::string path);
 
   const std::string& path() const { return path_; }
+  const std::filesystem::path& file() const { return doc_->file(); }
   std::string key_path(std::string_view key) const;
   bool has(std::string_view key) const { return table_.contains(key); }
   [[noreturn]] void fail(std::string_view key, const std::string& message) const;
@@ -73,6 +66,8 @@ class TableReader {
   TableReader required_table(std::string_view key) const;
   /// Array of tables ([[key]]); empty when absent.
   std::vector<TableReader> tables(std::string_view key) const;
+  /// The keys of this table, in the file's order (for tables of free names, e.g. columns).
+  std::vector<std::string> keys() const;
 
   /// A sub-reader over this table that treats `key` as read even if it is not looked at.
   void mark(std::string_view key) const { doc_->mark_read(key_path(key)); }
@@ -86,4 +81,4 @@ class TableReader {
   std::string path_;
 };
 
-}  // namespace ncfsim::workflow
+}  // namespace ncfsim::fem

@@ -1,0 +1,208 @@
+// [[mesh.fabric]] and the tow_biphase material type.
+#include <climits>
+#include <cmath>
+
+#include "drape/case/drape_case.hpp"
+#include "drape/tow_material.hpp"
+#include "fem/errors.hpp"
+
+namespace ncfsim::drape {
+
+using fem::TableReader;
+
+namespace {
+
+std::unique_ptr<fem::SolidMaterial> read_tow_biphase(const TableReader& t, const std::string& name, double rho) {
+  TowConstants c;
+  c.density = rho;
+  c.E11f = t.number("E11f", Range::non_negative());
+  c.E11f_axial = t.number("E11f_axial", 0.0, Range::non_negative());
+  c.E11m = t.number("E11m", Range::positive());
+  c.E22m = t.number("E22m", Range::positive());
+  c.E33m = t.number("E33m", Range::positive());
+  c.nu12m = t.number("nu12m", 0.0, {-1.0, 1.0, true, true});
+  c.nu13m = t.number("nu13m", 0.0, {-1.0, 1.0, true, true});
+  c.nu23m = t.number("nu23m", 0.0, {-1.0, 1.0, true, true});
+  c.G12m = t.number("G12m", Range::positive());
+  c.G13m = t.number("G13m", c.G12m, Range::positive());
+  c.G23m = t.number("G23m", c.G12m, Range::positive());
+  c.compaction_modulus = t.number("compaction_modulus", 0.0, Range::non_negative());
+  c.locking_width_ratio = t.number("locking_width_ratio", 0.7, {0.0, 1.0, true, true});
+  c.lock_stiffness_ratio = t.number("lock_stiffness_ratio", 50.0, Range::closed(1, 1e4));
+  c.compaction_of_fibre_sheets =
+      t.choice("compaction_measure", {"transverse_strain", "fibre_sheet_spacing"}, "transverse_strain") ==
+      "fibre_sheet_spacing";
+  return std::make_unique<TowMaterial>(name, c);
+}
+
+int read_int(const TableReader& t, std::string_view key, int fallback) {
+  return static_cast<int>(t.integer(key, fallback, INT_MIN, INT_MAX));
+}
+
+// The fabric's own keys. Their ranges are checked once, by drape::validate (drape/fabric.cpp):
+// on the keys as given here, on the spec as meshed (the resolution's divisions) by generate_blanket.
+FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution) {
+  FabricSpec f;
+  if (fb.has("ply_angles_deg")) f.ply_angles_deg = fb.numbers("ply_angles_deg", {});
+  f.tow_width = fb.number("tow_width", f.tow_width, {});
+  f.tow_gap = fb.number("tow_gap", f.tow_gap, {});
+  f.areal_weight = fb.number("areal_weight", f.areal_weight, {});
+  f.fibre_density = fb.number("fibre_density", f.fibre_density, {});
+  f.tow_fibre_volume_fraction = fb.number("tow_fibre_volume_fraction", f.tow_fibre_volume_fraction, {});
+  const std::string stitch = fb.choice("stitch", {"tricot", "chain", "none"}, "tricot");
+  f.stitch = stitch == "tricot" ? StitchPattern::Tricot : stitch == "chain" ? StitchPattern::Chain : StitchPattern::None;
+  f.stitch_direction_deg = fb.number("stitch_direction_deg", 0.0, {});
+  f.stitch_gauge = fb.number("stitch_gauge", 0.0, {});
+  f.stitch_length = fb.number("stitch_length", 0.0, {});
+  f.elements_across_tow = read_int(fb, "elements_across_tow", 2);
+  f.elements_through_thickness = read_int(fb, "elements_through_thickness", 1);
+  f.element_length = fb.number("element_length", 0.0, {});
+  validate(f, fb.file().string(), fb.path());
+  if (resolution == "coarse") {
+    f.elements_across_tow = std::max(1, f.elements_across_tow / 2);
+    f.element_length = 2 * (f.element_length > 0 ? f.element_length : f.tow_pitch());
+  } else if (resolution == "fine") {
+    f.elements_across_tow *= 2;
+    f.element_length = 0.5 * (f.element_length > 0 ? f.element_length : f.tow_pitch());
+  }
+  return f;
+}
+
+void read_stitch_laws(const TableReader& fb, const FabricSpec& f, FabricEntry& fe) {
+  if (f.stitch == StitchPattern::None) return;
+  fe.law_I = fb.string("stitch_law_I");
+  fe.law_Lambda = f.stitch == StitchPattern::Tricot ? fb.string("stitch_law_Lambda") : fe.law_I;
+  fe.law_legs = fb.string("stitch_law_legs", fe.law_I);
+  fe.connection.sliding_force = fb.number("connection_sliding_force", 0.05, Range::positive());
+  fe.connection.transverse_force =
+      fb.number("connection_transverse_force", 3 * fe.connection.sliding_force, Range::non_negative());
+  fe.connection.stiffness = fb.number("connection_stiffness", 0.0, Range::non_negative());
+}
+
+FabricEntry read_fabric(fem::CaseReadContext& ctx, const TableReader& fb) {
+  FabricEntry fe;
+  fe.path = fb.path();
+  fe.name = fb.string("name");
+  const FabricSpec f = read_fabric_spec(fb, ctx.resolution);
+  BlanketSpec bl;
+  const auto origin = fb.vec3_or("origin", {0, 0, 0});
+  bl.origin = {origin[0], origin[1]};
+  bl.z0 = origin[2];
+  const auto size = fb.numbers("size", Range::positive(), 2);
+  if (size.size() != 2) fb.fail("size", "must hold 2 numbers [length along x, width along y]");
+  bl.size = {size[0], size[1]};
+  fe.tow_material = fb.string("tow_material");
+  read_stitch_laws(fb, f, fe);
+  fe.angles = f.ply_angles_deg;
+  fe.elements_through_thickness = f.elements_through_thickness;
+  if (fe.name.empty() || fe.name.find_first_of(" ./\\") != std::string::npos)
+    fb.fail("name", "must be a non-empty name without spaces, dots or slashes (it prefixes the part names)");
+  fem::Mesh& mesh = ctx.model.mesh;
+  try {
+    fe.model = generate_blanket(mesh, f, bl, ctx.file, fe.name + "_", fe.path);
+  } catch (const InputError& e) {
+    // The value checked is the one meshed: say where it came from.
+    if (e.key() != fe.path + ".elements_across_tow" || ctx.resolution == "default") throw;
+    throw InputError(e.file(), e.key(),
+                     "value " + e.value() + " (mesh.resolution = " + ctx.resolution + " of " +
+                         std::to_string(fb.integer("elements_across_tow", 2, INT_MIN, INT_MAX)) +
+                         ") out of range, allowed " + e.allowed(),
+                     e.value(), e.allowed());
+  }
+  auto generated = [&](int p, fem::PartKind kind) {
+    const std::string& part = mesh.part_names[static_cast<std::size_t>(p)];
+    ctx.part_kind[part] = kind;
+    ctx.generated_parts[part] = "[[mesh.fabric]]";
+  };
+  for (int p : fe.model.ply_parts) generated(p, fem::PartKind::Solid);
+  for (int p : {fe.model.stitch_I_part, fe.model.stitch_Lambda_part, fe.model.stitch_leg_part})
+    if (p >= 0) generated(p, fem::PartKind::Bar);
+  return fe;
+}
+
+int named_index(const fem::CaseReadContext& ctx, const FabricEntry& fe, const std::map<std::string, int>& names,
+                const std::string& n, const std::string& key) {
+  if (!names.count(n))
+    throw InputError(ctx.file, fe.path + "." + key,
+                     "no such " + std::string(key == "tow_material" ? "[[material]]" : "[[bar_law]]") + " '" + n + "'");
+  return names.at(n);
+}
+
+void assign_ply_parts(fem::CaseReadContext& ctx, const FabricEntry& fe) {
+  const int tow = named_index(ctx, fe, ctx.materials, fe.tow_material, "tow_material");
+  // E11f_axial leaves bending to E11f through the hourglass moduli, which carry all of the
+  // bending only with one hexahedron through the tow: with more, the layers' stretch (E11f_axial)
+  // would bend it.
+  const auto* tow_law = dynamic_cast<const TowMaterial*>(ctx.model.materials[static_cast<std::size_t>(tow)].get());
+  if (tow_law && tow_law->constants().E11f_axial > 0 && fe.elements_through_thickness > 1)
+    throw InputError(ctx.file, fe.path + ".elements_through_thickness",
+                     "must be 1 with tow material '" + fe.tow_material +
+                         "', which sets E11f_axial (its bending stiffness, E11f, is separate "
+                         "from its stretch only with "
+                         "one hexahedron through the tow thickness)");
+  for (std::size_t q = 0; q < fe.model.ply_parts.size(); ++q) {
+    const auto p = static_cast<std::size_t>(fe.model.ply_parts[q]);
+    auto& pp = ctx.model.parts[p];
+    pp.material = tow;
+    const double al = fe.angles[q] * M_PI / 180.0;
+    pp.material_axes = {std::cos(al), -std::sin(al), 0, std::sin(al), std::cos(al), 0, 0, 0, 1};
+    ctx.part_defined[p] = 1;
+  }
+}
+
+void assign_stitch_parts(fem::CaseReadContext& ctx, const FabricEntry& fe) {
+  const std::pair<int, std::string> bar_parts[] = {
+      {fe.model.stitch_I_part, fe.law_I}, {fe.model.stitch_Lambda_part, fe.law_Lambda}, {fe.model.stitch_leg_part, fe.law_legs}};
+  for (const auto& [p, law] : bar_parts) {
+    if (p < 0) continue;
+    auto& pp = ctx.model.parts[static_cast<std::size_t>(p)];
+    pp.bar_law = named_index(ctx, fe, ctx.bar_laws, law,
+                             law == fe.law_I ? "stitch_law_I" : law == fe.law_Lambda ? "stitch_law_Lambda" : "stitch_law_legs");
+    ctx.part_defined[static_cast<std::size_t>(p)] = 1;
+  }
+}
+
+}  // namespace
+
+void register_drape_case_types(fem::CaseTypeRegistry& registry) {
+  registry.add_material_type("tow_biphase", read_tow_biphase);
+}
+
+std::vector<FabricEntry> read_fabrics(fem::CaseReadContext& ctx, const TableReader& m) {
+  std::vector<FabricEntry> fabrics;
+  for (const auto& fb : m.tables("fabric")) fabrics.push_back(read_fabric(ctx, fb));
+  return fabrics;
+}
+
+void renumber_fabrics(fem::CaseReadContext& ctx, std::vector<FabricEntry>& fabrics,
+                      const std::vector<std::int32_t>& new_of_old) {
+  auto& pins = ctx.node_sets["tow_end_pins"];
+  pins.owner = "[[mesh.fabric]]";
+  for (auto& fe : fabrics) {
+    for (auto& c : fe.model.connections)
+      for (std::int32_t* nd : {&c.stitch_node, &c.tow_node, &c.tow_axis_node})
+        *nd = new_of_old[static_cast<std::size_t>(*nd)];
+    for (auto& nd : fe.model.stitch_nodes) nd = new_of_old[static_cast<std::size_t>(nd)];
+    for (auto& nd : fe.model.tow_end_pins) nd = new_of_old[static_cast<std::size_t>(nd)];
+    pins.sets[fe.name] = fe.model.tow_end_pins;
+  }
+}
+
+std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx, const std::vector<FabricEntry>& fabrics) {
+  std::vector<FabricSummary> summaries;
+  for (const auto& fe : fabrics) {
+    assign_ply_parts(ctx, fe);
+    assign_stitch_parts(ctx, fe);
+    int connection_contact = -1;
+    if (!fe.model.connections.empty()) {
+      connection_contact = static_cast<int>(ctx.model.contacts.size());
+      ctx.model.contacts.push_back(
+          std::make_unique<StitchToTowConnection>(fe.name + "_stitch_tow", fe.model.connections, fe.connection));
+    }
+    summaries.push_back({fe.name, fe.model.n_tows, fe.model.n_dropped_tows, fe.model.n_penetrations,
+                         fe.model.connections.size(), fe.model.tow_thickness, connection_contact});
+  }
+  return summaries;
+}
+
+}  // namespace ncfsim::drape

@@ -1,0 +1,44 @@
+#pragma once
+// fem's sections of a case file, one reader per section (keys in docs/case-file.md). Each reads
+// and range-checks its keys once, into ctx.model; called in this order by the case orchestration
+// (workflow/case), a module's own sections in between (drape/case: [[mesh.fabric]]).
+#include <array>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "fem/case/case_context.hpp"
+
+namespace ncfsim::fem {
+
+/// [mesh].resolution, [[mesh.block]], [[mesh.line]] (`m` is the [mesh] table).
+void read_mesh_blocks(CaseReadContext& ctx, const TableReader& m);
+/// After every module made its elements: renumbers for locality (returns new-from-old node map)
+/// and sets the default user ids. Modules remap their node lists with the map.
+std::vector<std::int32_t> finish_mesh(CaseReadContext& ctx);
+/// [[material]] (through the registry), [[bar_law]].
+void read_materials(CaseReadContext& ctx);
+void read_bar_laws(CaseReadContext& ctx);
+/// [[part]]; then, after the modules gave their generated parts, check_parts_defined.
+void read_parts(CaseReadContext& ctx);
+void check_parts_defined(const CaseReadContext& ctx);
+/// [boundary] (fixed, velocity, picture_frame), [load], [damping], [initial].
+void read_boundary(CaseReadContext& ctx);
+void read_loads(CaseReadContext& ctx);
+/// [[tool]] (rigid tools), [[contact]] (deformable contacts).
+void read_tools(CaseReadContext& ctx);
+void read_contacts(CaseReadContext& ctx);
+/// [time] (needs the picture frames: their rate follows from end_time).
+void read_time(CaseReadContext& ctx);
+
+/// A node selection `key = { ... }` of table `owner` (docs/case-file.md, "Node selections").
+std::vector<std::int32_t> select_nodes(const CaseReadContext& ctx, const TableReader& owner, std::string_view key);
+/// Part names under `key` as indices into mesh.part_names (at least one).
+std::vector<int> part_indices(const TableReader& t, std::string_view key, const Mesh& mesh);
+
+/// The two places that know the mesh's element sets: per node, 1 if an element of
+/// part `part` holds it; and a bar appended to the mesh.
+std::vector<char> part_node_mask(const Mesh& mesh, int part);
+void append_bar(Mesh& mesh, std::int32_t n0, std::int32_t n1, int part);
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,152 @@
+// [[tool]] (rigid tools) and [[contact]] (deformable contacts).
+#include <map>
+#include <stdexcept>
+
+#include "fem/case/fem_case.hpp"
+#include "fem/contact/penalty_contact.hpp"
+#include "fem/contact/tied_contact.hpp"
+
+namespace ncfsim::fem {
+
+namespace {
+
+V3 to_v3(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+
+V3 unit_axis(const TableReader& t, std::string_view key, std::array<double, 3> fallback) {
+  const V3 ax = to_v3(t.vec3_or(key, fallback));
+  if (!(norm(ax) > 0)) t.fail(key, "must not be zero");
+  return (1.0 / norm(ax)) * ax;
+}
+
+void read_tool_stl(const TableReader& t, RigidSurface& s) {
+  s.shape = ToolShape::Triangles;
+  std::filesystem::path stl = t.string("file");
+  if (stl.is_relative()) stl = t.file().parent_path() / stl;
+  const double scale = t.number("scale", 1.0, Range::positive());
+  try {
+    s.triangles = std::make_shared<TriangleSurface>(TriangleSurface::read_stl(stl.string(), scale));
+  } catch (const std::exception& e) {
+    t.fail("file", std::string("cannot read STL: ") + e.what());
+  }
+  s.search_radius = t.number("search_radius", Range::positive());
+}
+
+void read_tool_surface(const TableReader& t, RigidSurface& s) {
+  const std::string shape = t.choice("shape", {"plane", "sphere", "cylinder", "torus", "plane_with_hole", "stl"}, "");
+  s.point = to_v3(t.vec3_or("point", {0, 0, 0}));
+  if (t.has("axis") || shape != "stl") s.axis = unit_axis(t, "axis", {0, 0, 1});
+  if (shape == "plane") s.shape = ToolShape::Plane;
+  if (shape == "sphere" || shape == "cylinder" || shape == "torus" || shape == "plane_with_hole") {
+    s.shape = shape == "sphere"     ? ToolShape::Sphere
+              : shape == "cylinder" ? ToolShape::Cylinder
+              : shape == "torus"    ? ToolShape::Torus
+                                    : ToolShape::PlaneWithHole;
+    s.radius = t.number("radius", Range::positive());
+  }
+  if (shape == "torus") s.minor_radius = t.number("minor_radius", Range::positive());
+  if (shape == "sphere" || shape == "cylinder" || shape == "torus") s.body_inside = t.boolean("body_inside", false);
+  if (shape == "stl") read_tool_stl(t, s);
+}
+
+void read_tool_motion(const TableReader& t, ToolMotion& m) {
+  const std::string motion = t.choice("motion", {"fixed", "velocity", "force"}, "fixed");
+  if (motion == "velocity") {
+    m.kind = ToolMotion::Kind::Velocity;
+    m.velocity = to_v3(t.vec3("velocity"));
+    m.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
+  } else if (motion == "force") {
+    m.kind = ToolMotion::Kind::Force;
+    m.axis = unit_axis(t, "force_axis", {0, 0, -1});
+    m.force = t.number("force", Range::non_negative());
+    m.mass = t.number("mass", Range::positive());
+  }
+}
+
+void read_tool(CaseReadContext& ctx, const TableReader& t) {
+  RigidTool tool;
+  tool.name = t.string("name");
+  read_tool_surface(t, tool.surface);
+  read_tool_motion(t, tool.motion);
+  tool.friction = t.number("friction", 0.0, Range::non_negative());
+  tool.penalty_scale = t.number("penalty_scale", 0.1, Range::open_closed(0, 1.0));
+  tool.damping = t.number("damping", 0.1, Range::closed(0, 1.0));
+  tool.thickness = t.number("thickness", 0.0, Range::non_negative());
+  tool.contact_nodes = select_nodes(ctx, t, "contact_nodes");
+  ctx.model.tools.push_back(std::move(tool));
+}
+
+// The values of [[contact]] are range-checked once, by fem::validate (fem/contact/contact_config),
+// with their case-file keys (key_path): here they are only read (a number, finite).
+template <class Config>
+Config contact_config(const CaseReadContext& ctx, const TableReader& t, const std::string& name) {
+  Config c;
+  c.name = name;
+  c.source_file = ctx.file;
+  c.key_path = t.path();
+  return c;
+}
+
+std::unique_ptr<ContactAlgorithm> read_penalty_contact(const CaseReadContext& ctx, const TableReader& t,
+                                                       const std::string& name) {
+  auto c = contact_config<PenaltyContactConfig>(ctx, t, name);
+  c.penalty_scale = t.number("penalty_scale", c.penalty_scale, {});
+  c.thickness = t.number("thickness", 0.0, {});
+  c.search_margin = t.number("search_margin", 0.0, {});
+  c.edge_tolerance = t.number("edge_tolerance", c.edge_tolerance, {});
+  c.max_penetration = t.number("max_penetration", c.max_penetration, {});
+  std::map<std::string, int> groups;
+  for (const auto& g : t.tables("group")) {
+    ContactGroup cg;
+    cg.name = g.string("name");
+    if (groups.count(cg.name)) g.fail("name", "duplicate contact group '" + cg.name + "'");
+    cg.parts = part_indices(g, "parts", ctx.model.mesh);
+    groups[cg.name] = static_cast<int>(c.groups.size());
+    c.groups.push_back(std::move(cg));
+  }
+  for (const auto& pr : t.tables("pair")) {
+    const auto names = pr.strings("groups");
+    if (names.size() != 2) pr.fail("groups", "must name exactly 2 groups (the same twice for self-contact)");
+    ContactPair cp;
+    for (std::size_t k = 0; k < 2; ++k) {
+      const auto it = groups.find(names[k]);
+      if (it == groups.end()) pr.fail("groups", "no [[contact.group]] named '" + names[k] + "'");
+      (k == 0 ? cp.first : cp.second) = it->second;
+    }
+    cp.friction = pr.number("friction", 0.0, {});
+    c.pairs.push_back(cp);
+  }
+  return std::make_unique<PenaltyContact>(std::move(c));
+}
+
+std::unique_ptr<ContactAlgorithm> read_tied_contact(const CaseReadContext& ctx, const TableReader& t,
+                                                    const std::string& name) {
+  auto c = contact_config<TiedContactConfig>(ctx, t, name);
+  c.slave = {name + "_slave", part_indices(t, "slave_parts", ctx.model.mesh)};
+  c.master = {name + "_master", part_indices(t, "master_parts", ctx.model.mesh)};
+  c.penalty_scale = t.number("penalty_scale", c.penalty_scale, {});
+  c.search_distance = t.number("search_distance", 0.0, {});
+  c.normal_strength = t.number("normal_strength", 0.0, {});
+  c.shear_strength = t.number("shear_strength", 0.0, {});
+  return std::make_unique<TiedContact>(std::move(c));
+}
+
+}  // namespace
+
+void read_tools(CaseReadContext& ctx) {
+  for (const auto& t : ctx.root.tables("tool")) read_tool(ctx, t);
+}
+
+void read_contacts(CaseReadContext& ctx) {
+  for (const auto& t : ctx.root.tables("contact")) {
+    const std::string type = t.choice("type", {"penalty", "tied"}, "penalty");
+    const std::string name = t.string("name");
+    try {
+      ctx.model.contacts.push_back(type == "penalty" ? read_penalty_contact(ctx, t, name)
+                                                     : read_tied_contact(ctx, t, name));
+    } catch (const std::invalid_argument& e) {
+      t.fail("type", e.what());
+    }
+  }
+}
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,166 @@
+// Case reading per module: the registry dispatches a [[material]] type to the reader its module
+// registered; an unknown type's error names the file, the key and the allowed types; a key's range
+// is checked once, under the key's own name (the contact pair friction, [0, 10]).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "fem/case/case_context.hpp"
+#include "fem/case/fem_case.hpp"
+#include "fem/errors.hpp"
+#include "workflow/case/engine_case.hpp"
+
+namespace fs = std::filesystem;
+using namespace ncfsim;
+
+namespace {
+
+fs::path write_case(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::temp_directory_path() / "ncfsim_test_case_reading";
+  fs::create_directories(dir);
+  const fs::path file = dir / (name + ".toml");
+  std::ofstream(file) << text;
+  return file;
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+const char* kMaterial = R"(
+[[material]]
+name = "m"
+type = "%TYPE%"
+density = 1000.0
+youngs_modulus = 1e9
+poisson_ratio = 0.3
+)";
+
+std::string material_case(const std::string& type) {
+  std::string s = kMaterial;
+  s.replace(s.find("%TYPE%"), 6, type);
+  return s;
+}
+
+// Two blocks in a penalty contact; `pair` is the body of its [[contact.pair]].
+std::string contact_case(const std::string& pair) {
+  return R"(
+[case]
+name = "two_blocks"
+[mesh]
+[[mesh.block]]
+part = "lower"
+size = [0.01, 0.01, 0.01]
+divisions = [1, 1, 1]
+[[mesh.block]]
+part = "upper"
+origin = [0.0, 0.0, 0.01]
+size = [0.01, 0.01, 0.01]
+divisions = [1, 1, 1]
+[[material]]
+name = "steel"
+type = "elastic_isotropic"
+density = 7800.0
+youngs_modulus = 2e11
+poisson_ratio = 0.3
+[[part]]
+name = "lower"
+material = "steel"
+[[part]]
+name = "upper"
+material = "steel"
+[[contact]]
+name = "blocks"
+[[contact.group]]
+name = "a"
+parts = ["lower"]
+[[contact.group]]
+name = "b"
+parts = ["upper"]
+[[contact.pair]]
+groups = ["a", "b"]
+)" + pair + R"(
+[time]
+end_time = 1e-4
+)";
+}
+
+}  // namespace
+
+TEST(CaseTypeRegistry, DispatchesAMaterialTypeToItsReader) {
+  fem::CaseTypeRegistry registry;
+  fem::register_fem_case_types(registry);
+  int calls = 0;
+  double density_seen = 0;
+  registry.add_material_type("test_law", [&](const fem::TableReader& t, const std::string& name, double rho) {
+    ++calls;
+    density_seen = rho;
+    return std::make_unique<fem::ElasticIsotropic>(name, rho, t.number("youngs_modulus", Range::positive()),
+                                                   t.number("poisson_ratio", Range{}));
+  });
+  EXPECT_EQ(registry.material_types(), (std::vector<std::string>{"elastic_isotropic", "elastic_orthotropic", "test_law"}));
+  EXPECT_THROW(registry.add_material_type("test_law", {}), std::logic_error);
+
+  fem::CaseDocument doc = fem::CaseDocument::load(write_case("dispatch", material_case("test_law")), {});
+  const fem::TableReader root(doc, doc.root(), "");
+  const auto material = registry.read_material(root.tables("material").at(0), "m");
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(density_seen, 1000.0);
+  ASSERT_NE(material, nullptr);
+  EXPECT_EQ(material->density(), 1000.0);
+}
+
+TEST(CaseTypeRegistry, EngineCasesKnowDrapesTowLaw) {
+  const auto types = workflow::engine_case_types().material_types();
+  EXPECT_EQ(types, (std::vector<std::string>{"elastic_isotropic", "elastic_orthotropic", "tow_biphase"}));
+}
+
+TEST(CaseTypeRegistry, UnknownTypeNamesFileKeyAndTheAllowedTypes) {
+  const fs::path file = write_case("unknown_type", material_case("rubber"));
+  fem::CaseDocument doc = fem::CaseDocument::load(file, {});
+  const fem::TableReader root(doc, doc.root(), "");
+  try {
+    workflow::engine_case_types().read_material(root.tables("material").at(0), "m");
+    FAIL() << "no error for an unknown material type";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), file.string());
+    EXPECT_EQ(e.key(), "material[0].type");
+    EXPECT_EQ(e.value(), "rubber");
+    EXPECT_EQ(e.allowed(), "'elastic_isotropic', 'elastic_orthotropic', 'tow_biphase'");
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("'material[0].type'"), std::string::npos) << what;
+    EXPECT_NE(what.find("'tow_biphase'"), std::string::npos) << what;
+  }
+}
+
+TEST(CaseReading, ContactFrictionOutOfRangeNamesItsKeyOnce) {
+  EXPECT_NO_THROW(workflow::load_engine_case(write_case("mu_ok", contact_case("friction = 10.0")), {}));
+  for (const char* bad : {"friction = 10.5", "friction = -0.1"}) {
+    const fs::path file = write_case("mu_bad", contact_case(bad));
+    try {
+      workflow::load_engine_case(file, {});
+      ADD_FAILURE() << "no error for " << bad;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(e.file(), file.string());
+      EXPECT_EQ(e.key(), "contact[0].pair[0].friction") << what;
+      EXPECT_EQ(e.allowed(), "[0, 10]") << what;
+      EXPECT_EQ(count(what, "friction"), 1u) << what;
+      EXPECT_EQ(count(what, "out of range"), 1u) << what;
+    }
+  }
+}
+
+TEST(CaseReading, ReadsAreIndependent) {
+  // Nothing is kept from one case to the next (the tow-end pins live in the reading context).
+  const auto a = workflow::load_engine_case(write_case("independent", contact_case("friction = 0.2")), {});
+  const auto b = workflow::load_engine_case(write_case("independent", contact_case("friction = 0.2")), {});
+  EXPECT_EQ(a.model.mesh.coords, b.model.mesh.coords);
+  EXPECT_EQ(a.model.contacts.size(), 1u);
+  EXPECT_EQ(b.model.contacts.size(), 1u);
+}
