@@ -101,6 +101,23 @@ std::vector<std::string> read_strings(const std::filesystem::path& file, hid_t l
   return out;
 }
 
+// The group of frame `index` (< n_frames), with the file held open while it lives.
+struct FrameGroup {
+  FrameGroup(const std::filesystem::path& file, std::size_t n_frames, std::size_t index)
+      : name(group_name(file, n_frames, index)),
+        f(open_unlocked(file), H5Fclose),
+        g(f.id >= 0 ? H5Gopen2(f.id, name.c_str(), H5P_DEFAULT) : -1, H5Gclose) {
+    if (f.id < 0) fail(file, "not a readable HDF5 file");
+    if (g.id < 0) fail(file, "no group " + name);
+  }
+  static std::string group_name(const std::filesystem::path& file, std::size_t n_frames, std::size_t index) {
+    if (index >= n_frames) fail(file, "frame " + std::to_string(index) + " not in the file");
+    return "/frames/" + detail::zero_padded(index, 6);
+  }
+  std::string name;
+  Handle f, g;
+};
+
 template <class T>
 void read_optional(const std::filesystem::path& file, hid_t loc, const char* name, hid_t mem_type,
                    std::vector<T>& target) {
@@ -147,47 +164,38 @@ ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
 }
 
 double ResultReader::frame_time(std::size_t index) const {
-  if (index >= n_frames_) fail(path_, "frame " + std::to_string(index) + " not in the file");
-  Handle f(open_unlocked(path_), H5Fclose);
-  if (f.id < 0) fail(path_, "not a readable HDF5 file");
-  const std::string gname = "/frames/" + detail::zero_padded(index, 6);
-  Handle g(H5Gopen2(f.id, gname.c_str(), H5P_DEFAULT), H5Gclose);
-  if (g.id < 0) fail(path_, "no group " + gname);
+  const FrameGroup fg(path_, n_frames_, index);
   double t = 0;
-  Handle a(H5Aopen(g.id, "time", H5P_DEFAULT), H5Aclose);
-  if (a.id < 0 || H5Aread(a.id, H5T_NATIVE_DOUBLE, &t) < 0) fail(path_, "no attribute time on " + gname);
+  Handle a(H5Aopen(fg.g.id, "time", H5P_DEFAULT), H5Aclose);
+  if (a.id < 0 || H5Aread(a.id, H5T_NATIVE_DOUBLE, &t) < 0) fail(path_, "no attribute time on " + fg.name);
   return t;
 }
 
 StoredFrame ResultReader::frame(std::size_t index) const {
-  if (index >= n_frames_) fail(path_, "frame " + std::to_string(index) + " not in the file");
-  Handle f(open_unlocked(path_), H5Fclose);
-  if (f.id < 0) fail(path_, "not a readable HDF5 file");
-  const std::string gname = "/frames/" + detail::zero_padded(index, 6);
-  Handle g(H5Gopen2(f.id, gname.c_str(), H5P_DEFAULT), H5Gclose);
-  if (g.id < 0) fail(path_, "no group " + gname);
+  const FrameGroup fg(path_, n_frames_, index);
+  const hid_t gid = fg.g.id;
   StoredFrame fr;
   {
-    Handle a(H5Aopen(g.id, "time", H5P_DEFAULT), H5Aclose);
+    Handle a(H5Aopen(gid, "time", H5P_DEFAULT), H5Aclose);
     if (a.id >= 0) H5Aread(a.id, H5T_NATIVE_DOUBLE, &fr.time);
-    Handle c(H5Aopen(g.id, "cycle", H5P_DEFAULT), H5Aclose);
+    Handle c(H5Aopen(gid, "cycle", H5P_DEFAULT), H5Aclose);
     if (c.id >= 0) H5Aread(c.id, H5T_NATIVE_INT, &fr.cycle);
   }
-  read_dataset(path_, g.id, "coordinates", H5T_NATIVE_DOUBLE, resize_vec<double>, &fr.coordinates);
+  read_dataset(path_, gid, "coordinates", H5T_NATIVE_DOUBLE, resize_vec<double>, &fr.coordinates);
   const std::size_t np = mesh_.n_points(), nh = mesh_.n_hex(), nb = mesh_.n_bar();
-  for (const auto& name : list_links(g.id)) {
-    if (name == "coordinates" || is_group(g.id, name)) continue;
+  for (const auto& name : list_links(gid)) {
+    if (name == "coordinates" || is_group(gid, name)) continue;
     FrameField ff;
     ff.name = name;
-    const auto dims = read_dataset(path_, g.id, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &ff.values);
+    const auto dims = read_dataset(path_, gid, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &ff.values);
     ff.n_components = dims.size() > 1 ? static_cast<int>(dims[1]) : 1;
     fr.fields.push_back(std::move(ff));
   }
   // Cell fields: join the hex and bar slices (missing slice -> NaN).
   std::map<std::string, FrameField> cells;
   for (const char* kind : {"hex8", "bar2"}) {
-    if (H5Lexists(g.id, kind, H5P_DEFAULT) <= 0) continue;
-    Handle cg(H5Gopen2(g.id, kind, H5P_DEFAULT), H5Gclose);
+    if (H5Lexists(gid, kind, H5P_DEFAULT) <= 0) continue;
+    Handle cg(H5Gopen2(gid, kind, H5P_DEFAULT), H5Gclose);
     const bool hex = std::string(kind) == "hex8";
     for (const auto& name : list_links(cg.id)) {
       std::vector<double> vals;

@@ -158,3 +158,19 @@ TEST(StageRegistry, UnknownKindNamesTheAllowedOnes) {
                                 {"case.kind=transfer"}),
             "transfer");
 }
+
+TEST(StageHandoff, OptionalIdsAreEmptyOrOnePerElement) {
+  fem::io::ResultMesh m;
+  m.points = {0, 0, 0, 1, 0, 0};
+  m.bar2 = {0, 1};
+  m.bar_part = {0};
+  EXPECT_NO_THROW(fem::io::validate_mesh(m));  // no hand-off ids: an older writer's mesh
+  m.bar_user_id = {7, 8};
+  EXPECT_THROW(fem::io::validate_mesh(m), std::invalid_argument);
+  m.bar_user_id = {7};
+  m.node_user_id = {1};
+  EXPECT_THROW(fem::io::validate_mesh(m), std::invalid_argument);
+  m.node_user_id = {1, 2};
+  m.hex_ply = {0};  // no hexahedra
+  EXPECT_THROW(fem::io::validate_mesh(m), std::invalid_argument);
+}
