@@ -16,6 +16,7 @@
 #include "workflow/figures/figures.hpp"
 #include "workflow/report/report.hpp"
 #include "workflow/run/engine_run.hpp"
+#include "workflow/stages/stage_registry.hpp"
 #include "workflow/version.hpp"
 
 namespace wf = ncfsim::workflow;
@@ -30,21 +31,6 @@ int bad_input(const std::exception& e) {
 void require_output_folder(const std::filesystem::path& dir) {
   if (!std::filesystem::is_directory(dir))
     throw ncfsim::InputError(dir.string(), "", "not a folder (give the output folder of a run)");
-}
-
-// Until the domain decomposition lands the engine runs on one MPI rank: started by mpirun on
-// more, every rank would run the whole model and write the same files. Returns the exit code
-// (0: one rank); rank 0 says why.
-int refuse_many_ranks() {
-  const int n = ncfsim::fem::PetscSession::size();
-  if (n <= 1) return 0;
-  if (ncfsim::fem::PetscSession::rank() == 0)
-    std::fprintf(stderr,
-                 "ncfsim: bad input: started on %d MPI ranks, but the domain decomposition is not "
-                 "implemented yet (each rank would run the whole model and write the same files): "
-                 "start ncfsim without mpirun/mpiexec (one rank)\n",
-                 n);
-  return wf::kBadInput;
 }
 
 }  // namespace
@@ -127,27 +113,27 @@ int main(int argc, char** argv) {
 
   try {
     if (*check) {
+      wf::find_stage(wf::case_kind(case_file, overrides), case_file);  // a kind this build runs
       auto ec = wf::load_engine_case(case_file, overrides);
       // Building the solver checks what only the assembled model can show (massless nodes, steps).
       ncfsim::fem::PetscSession petsc;
-      if (const int code = refuse_many_ranks()) return code;
+      if (const int code = wf::refuse_many_ranks()) return code;
       ncfsim::fem::ExplicitSolver probe(ec.model);
       std::printf("%s: OK (case '%s', %zu nodes, %zu hexahedra, %zu bars, stable step %.4g s, about %.3g cycles)\n",
                   case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(), probe.n_elements(ncfsim::fem::ElementKind::Hex8), probe.n_elements(ncfsim::fem::ElementKind::Bar2),
                   probe.time_step(), ec.model.time.end_time / probe.time_step());
       return wf::kSuccess;
     }
-    if (*run) {
-      auto ec = wf::load_engine_case(case_file, overrides);
-      ncfsim::fem::PetscSession petsc;
-      if (const int code = refuse_many_ranks()) return code;
-      wf::RunOptions o;
-      o.out_dir = out_dir;
-      o.verbosity = verbosity;
-      o.overrides = overrides;
-      o.ranks = ranks;
-      o.progress_interval_s = progress;
-      return wf::run_engine_case(ec, o);
+    if (*run) {  // [case] kind -> its stage (workflow/stages/stage_registry.hpp)
+      wf::StageCall call;
+      call.case_file = case_file;
+      call.overrides = overrides;
+      call.options.out_dir = out_dir;
+      call.options.verbosity = verbosity;
+      call.options.overrides = overrides;
+      call.options.ranks = ranks;
+      call.options.progress_interval_s = progress;
+      return wf::run_stage(call);
     }
     if (*cal_stitch) {
       sc.sign = shear == "negative" ? ncfsim::drape::ShearSign::Negative : ncfsim::drape::ShearSign::Positive;
@@ -158,7 +144,7 @@ int main(int argc, char** argv) {
     }
     if (*cal_bend) {
       ncfsim::fem::PetscSession petsc;
-      if (const int code = refuse_many_ranks()) return code;
+      if (const int code = wf::refuse_many_ranks()) return code;
       const auto r = wf::calibrate_tow_bending(tb);
       std::printf("E11f = %.6g Pa gives a bending length of %.6g m (target %.6g m) after %d runs%s; see %s\n", r.E11f,
                   r.bending_length, tb.target_bending_length, r.runs, r.converged ? "" : " (NOT converged)",

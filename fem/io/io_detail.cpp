@@ -42,6 +42,15 @@ void check_part_ids(const std::vector<std::int32_t>& parts, const char* what) {
   }
 }
 
+// An optional per-entity array of the stage hand-off: empty, or one value per entity.
+template <class T>
+void check_optional(const std::vector<T>& values, std::size_t n, const char* name, const char* what) {
+  if (!values.empty() && values.size() != n) {
+    throw std::invalid_argument(std::string("ResultMesh: ") + name + " has " + std::to_string(values.size()) +
+                                " entries for " + std::to_string(n) + " " + what);
+  }
+}
+
 }  // namespace
 
 void validate_mesh(const ResultMesh& mesh) {
@@ -69,6 +78,13 @@ void validate_mesh(const ResultMesh& mesh) {
   check_node_ids(mesh.bar2, 2, mesh.n_points(), "bar");
   check_part_ids(mesh.hex_part, "hexahedron");
   check_part_ids(mesh.bar_part, "bar");
+  check_optional(mesh.node_user_id, mesh.n_points(), "node_user_id", "points");
+  check_optional(mesh.hex_user_id, mesh.n_hex(), "hex_user_id", "hexahedra");
+  check_optional(mesh.hex_material, mesh.n_hex(), "hex_material", "hexahedra");
+  check_optional(mesh.hex_ply, mesh.n_hex(), "hex_ply", "hexahedra");
+  check_optional(mesh.hex_tow, mesh.n_hex(), "hex_tow", "hexahedra");
+  check_optional(mesh.bar_user_id, mesh.n_bar(), "bar_user_id", "bars");
+  check_optional(mesh.bar_material, mesh.n_bar(), "bar_material", "bars");
 }
 
 void validate_frame(const ResultMesh& mesh, const Frame& frame) {

@@ -80,6 +80,50 @@ bool is_group(hid_t loc, const std::string& name) {
   return info.type == H5O_TYPE_GROUP;
 }
 
+// A rank-1 variable-length string dataset (as write_string_dataset writes them).
+std::vector<std::string> read_strings(const std::filesystem::path& file, hid_t loc, const std::string& name) {
+  Handle d(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (d.id < 0) fail(file, "cannot open dataset '" + name + "'");
+  Handle s(H5Dget_space(d.id), H5Sclose);
+  hsize_t n = 0;
+  if (H5Sget_simple_extent_ndims(s.id) != 1) fail(file, "dataset '" + name + "' is not a list");
+  H5Sget_simple_extent_dims(s.id, &n, nullptr);
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.id, H5T_VARIABLE);
+  H5Tset_cset(type.id, H5T_CSET_UTF8);
+  std::vector<char*> raw(n, nullptr);
+  if (n && H5Dread(d.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, raw.data()) < 0)
+    fail(file, "cannot read dataset '" + name + "'");
+  std::vector<std::string> out;
+  out.reserve(n);
+  for (char* c : raw) out.emplace_back(c ? c : "");
+  if (n) H5Dvlen_reclaim(type.id, s.id, H5P_DEFAULT, raw.data());
+  return out;
+}
+
+// The group of frame `index` (< n_frames), with the file held open while it lives.
+struct FrameGroup {
+  FrameGroup(const std::filesystem::path& file, std::size_t n_frames, std::size_t index)
+      : name(group_name(file, n_frames, index)),
+        f(open_unlocked(file), H5Fclose),
+        g(f.id >= 0 ? H5Gopen2(f.id, name.c_str(), H5P_DEFAULT) : -1, H5Gclose) {
+    if (f.id < 0) fail(file, "not a readable HDF5 file");
+    if (g.id < 0) fail(file, "no group " + name);
+  }
+  static std::string group_name(const std::filesystem::path& file, std::size_t n_frames, std::size_t index) {
+    if (index >= n_frames) fail(file, "frame " + std::to_string(index) + " not in the file");
+    return "/frames/" + detail::zero_padded(index, 6);
+  }
+  std::string name;
+  Handle f, g;
+};
+
+template <class T>
+void read_optional(const std::filesystem::path& file, hid_t loc, const char* name, hid_t mem_type,
+                   std::vector<T>& target) {
+  if (H5Lexists(loc, name, H5P_DEFAULT) > 0) read_dataset(file, loc, name, mem_type, resize_vec<T>, &target);
+}
+
 }  // namespace
 
 ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
@@ -104,37 +148,54 @@ ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
     read_dataset(path_, g.id, "hex_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>, &mesh_.hex_part);
   if (H5Lexists(g.id, "bar_part", H5P_DEFAULT) > 0)
     read_dataset(path_, g.id, "bar_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>, &mesh_.bar_part);
+  if (H5Lexists(g.id, "part_names", H5P_DEFAULT) > 0) mesh_.part_names = read_strings(path_, g.id, "part_names");
+  // The stage hand-off datasets (format_version 2; absent in older files).
+  read_optional(path_, g.id, "node_user_id", H5T_NATIVE_INT64, mesh_.node_user_id);
+  read_optional(path_, g.id, "hex_user_id", H5T_NATIVE_INT64, mesh_.hex_user_id);
+  read_optional(path_, g.id, "bar_user_id", H5T_NATIVE_INT64, mesh_.bar_user_id);
+  read_optional(path_, g.id, "hex_material", H5T_NATIVE_INT32, mesh_.hex_material);
+  read_optional(path_, g.id, "bar_material", H5T_NATIVE_INT32, mesh_.bar_material);
+  read_optional(path_, g.id, "hex_ply", H5T_NATIVE_INT32, mesh_.hex_ply);
+  read_optional(path_, g.id, "hex_tow", H5T_NATIVE_INT32, mesh_.hex_tow);
+  if (H5Lexists(g.id, "material_names", H5P_DEFAULT) > 0)
+    mesh_.material_names = read_strings(path_, g.id, "material_names");
+  if (H5Lexists(g.id, "bar_law_names", H5P_DEFAULT) > 0)
+    mesh_.bar_law_names = read_strings(path_, g.id, "bar_law_names");
+}
+
+double ResultReader::frame_time(std::size_t index) const {
+  const FrameGroup fg(path_, n_frames_, index);
+  double t = 0;
+  Handle a(H5Aopen(fg.g.id, "time", H5P_DEFAULT), H5Aclose);
+  if (a.id < 0 || H5Aread(a.id, H5T_NATIVE_DOUBLE, &t) < 0) fail(path_, "no attribute time on " + fg.name);
+  return t;
 }
 
 StoredFrame ResultReader::frame(std::size_t index) const {
-  if (index >= n_frames_) fail(path_, "frame " + std::to_string(index) + " not in the file");
-  Handle f(open_unlocked(path_), H5Fclose);
-  if (f.id < 0) fail(path_, "not a readable HDF5 file");
-  const std::string gname = "/frames/" + detail::zero_padded(index, 6);
-  Handle g(H5Gopen2(f.id, gname.c_str(), H5P_DEFAULT), H5Gclose);
-  if (g.id < 0) fail(path_, "no group " + gname);
+  const FrameGroup fg(path_, n_frames_, index);
+  const hid_t gid = fg.g.id;
   StoredFrame fr;
   {
-    Handle a(H5Aopen(g.id, "time", H5P_DEFAULT), H5Aclose);
+    Handle a(H5Aopen(gid, "time", H5P_DEFAULT), H5Aclose);
     if (a.id >= 0) H5Aread(a.id, H5T_NATIVE_DOUBLE, &fr.time);
-    Handle c(H5Aopen(g.id, "cycle", H5P_DEFAULT), H5Aclose);
+    Handle c(H5Aopen(gid, "cycle", H5P_DEFAULT), H5Aclose);
     if (c.id >= 0) H5Aread(c.id, H5T_NATIVE_INT, &fr.cycle);
   }
-  read_dataset(path_, g.id, "coordinates", H5T_NATIVE_DOUBLE, resize_vec<double>, &fr.coordinates);
+  read_dataset(path_, gid, "coordinates", H5T_NATIVE_DOUBLE, resize_vec<double>, &fr.coordinates);
   const std::size_t np = mesh_.n_points(), nh = mesh_.n_hex(), nb = mesh_.n_bar();
-  for (const auto& name : list_links(g.id)) {
-    if (name == "coordinates" || is_group(g.id, name)) continue;
+  for (const auto& name : list_links(gid)) {
+    if (name == "coordinates" || is_group(gid, name)) continue;
     FrameField ff;
     ff.name = name;
-    const auto dims = read_dataset(path_, g.id, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &ff.values);
+    const auto dims = read_dataset(path_, gid, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &ff.values);
     ff.n_components = dims.size() > 1 ? static_cast<int>(dims[1]) : 1;
     fr.fields.push_back(std::move(ff));
   }
   // Cell fields: join the hex and bar slices (missing slice -> NaN).
   std::map<std::string, FrameField> cells;
   for (const char* kind : {"hex8", "bar2"}) {
-    if (H5Lexists(g.id, kind, H5P_DEFAULT) <= 0) continue;
-    Handle cg(H5Gopen2(g.id, kind, H5P_DEFAULT), H5Gclose);
+    if (H5Lexists(gid, kind, H5P_DEFAULT) <= 0) continue;
+    Handle cg(H5Gopen2(gid, kind, H5P_DEFAULT), H5Gclose);
     const bool hex = std::string(kind) == "hex8";
     for (const auto& name : list_links(cg.id)) {
       std::vector<double> vals;

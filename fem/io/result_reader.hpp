@@ -23,6 +23,8 @@ class ResultReader {
   std::size_t n_frames() const { return n_frames_; }
   /// Frame `index` (0-based, < n_frames()).
   StoredFrame frame(std::size_t index) const;
+  /// Time of frame `index` without reading its fields.
+  double frame_time(std::size_t index) const;
 
  private:
   std::filesystem::path path_;

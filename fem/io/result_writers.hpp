@@ -10,6 +10,17 @@
 //   /mesh/hex_part      int32   [n_hex]        part id per hexahedron
 //   /mesh/bar_part      int32   [n_bar]
 //   /mesh/part_names    string  [n_parts]      variable-length UTF-8, indexed by part id
+//   Stage hand-off (format_version 2; each written only when the mesh carries it, a reader
+//   treats a missing one as unknown):
+//   /mesh/node_user_id  int64   [n_points]     node number given by the user (messages, export)
+//   /mesh/hex_user_id   int64   [n_hex]        element number given by the user
+//   /mesh/bar_user_id   int64   [n_bar]
+//   /mesh/hex_material  int32   [n_hex]        index into /mesh/material_names (-1: none)
+//   /mesh/bar_material  int32   [n_bar]        index into /mesh/bar_law_names (-1: none)
+//   /mesh/material_names string [n_materials]  the case's [[material]] names, in case order
+//   /mesh/bar_law_names string  [n_bar_laws]   the case's [[bar_law]] names, in case order
+//   /mesh/hex_ply       int32   [n_hex]        fabric ply index within its blanket (-1: not a tow)
+//   /mesh/hex_tow       int32   [n_hex]        fabric tow index within its ply (-1: not a tow)
 //   /frames/NNNNNN                             group per frame, NNNNNN = frame index (0-based,
 //                                              6 digits); attributes time (float64), cycle (int32)
 //   /frames/NNNNNN/coordinates  float64 [n_points, 3]  current positions = points + displacement
@@ -56,6 +67,16 @@ struct ResultMesh {
   std::vector<std::int32_t> hex_part;  ///< part id per hexahedron
   std::vector<std::int32_t> bar_part;  ///< part id per bar
   std::vector<std::string> part_names;
+  // Stage hand-off (optional: empty = not known, not written; else sized like the elements).
+  std::vector<std::int64_t> node_user_id;  ///< per point
+  std::vector<std::int64_t> hex_user_id;   ///< per hexahedron
+  std::vector<std::int64_t> bar_user_id;   ///< per bar
+  std::vector<std::int32_t> hex_material;  ///< index into material_names (-1: none)
+  std::vector<std::int32_t> bar_material;  ///< index into bar_law_names (-1: none)
+  std::vector<std::string> material_names;
+  std::vector<std::string> bar_law_names;
+  std::vector<std::int32_t> hex_ply;       ///< fabric ply per hexahedron (-1: not a tow)
+  std::vector<std::int32_t> hex_tow;       ///< fabric tow per hexahedron (-1: not a tow)
 
   std::size_t n_points() const { return points.size() / 3; }
   std::size_t n_hex() const { return hex8.size() / 8; }
@@ -81,7 +102,8 @@ struct Frame {
 };
 
 /// Throws std::invalid_argument if the mesh is inconsistent (sizes, node ids out of range,
-/// negative part ids). Part ids need not have a name.
+/// negative part ids, an optional per-element array neither empty nor sized like its elements).
+/// Part ids need not have a name.
 void validate_mesh(const ResultMesh& mesh);
 /// Throws std::invalid_argument if the frame does not fit the mesh.
 void validate_frame(const ResultMesh& mesh, const Frame& frame);

@@ -17,7 +17,7 @@ namespace ncfsim::fem::io {
 
 namespace {
 
-constexpr int kFormatVersion = 1;
+constexpr int kFormatVersion = 2;  // 2: the stage hand-off datasets (user ids, materials, ply/tow)
 constexpr int kFrameDigits = 6;
 constexpr const char* kH5Name = "results.h5";
 constexpr const char* kXdmfName = "results.xdmf";
@@ -248,6 +248,7 @@ struct XdmfResultWriter::Impl {
 
   H5Where at(std::string object) const { return H5Where{h5, std::move(object)}; }
   void create_h5() const;
+  void write_handoff_datasets(hid_t mesh_group) const;
   void write_frame_h5(const Frame& frame, const std::string& group) const;
   std::string xdmf_text() const;
   void append_uniform_grid(std::ostringstream& x, const FrameRecord& fr, bool solids) const;
@@ -282,10 +283,36 @@ void XdmfResultWriter::Impl::create_h5() const {
     write_dataset(g.get(), "bar_part", H5T_STD_I32LE, H5T_NATIVE_INT32, {nb}, mesh.bar_part.data(),
                   at("/mesh/bar_part"));
     write_string_dataset(g.get(), "part_names", mesh.part_names, at("/mesh/part_names"));
+    write_handoff_datasets(g.get());
   }
   create_group(file.get(), "frames", at("/frames"));
   h5_check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), root, "H5Fflush");
   h5_check(file.close(), root, "H5Fclose");
+}
+
+// The stage hand-off datasets of /mesh, each only when the mesh carries it.
+void XdmfResultWriter::Impl::write_handoff_datasets(hid_t g) const {
+  auto ids64 = [&](const char* name, const std::vector<std::int64_t>& v) {
+    if (v.empty()) return;
+    write_dataset(g, name, H5T_STD_I64LE, H5T_NATIVE_INT64, {static_cast<hsize_t>(v.size())}, v.data(),
+                  at(std::string("/mesh/") + name));
+  };
+  auto ids32 = [&](const char* name, const std::vector<std::int32_t>& v) {
+    if (v.empty()) return;
+    write_dataset(g, name, H5T_STD_I32LE, H5T_NATIVE_INT32, {static_cast<hsize_t>(v.size())}, v.data(),
+                  at(std::string("/mesh/") + name));
+  };
+  ids64("node_user_id", mesh.node_user_id);
+  ids64("hex_user_id", mesh.hex_user_id);
+  ids64("bar_user_id", mesh.bar_user_id);
+  ids32("hex_material", mesh.hex_material);
+  ids32("bar_material", mesh.bar_material);
+  ids32("hex_ply", mesh.hex_ply);
+  ids32("hex_tow", mesh.hex_tow);
+  if (!mesh.material_names.empty())
+    write_string_dataset(g, "material_names", mesh.material_names, at("/mesh/material_names"));
+  if (!mesh.bar_law_names.empty())
+    write_string_dataset(g, "bar_law_names", mesh.bar_law_names, at("/mesh/bar_law_names"));
 }
 
 void XdmfResultWriter::Impl::write_frame_h5(const Frame& frame, const std::string& group) const {

@@ -1,12 +1,15 @@
 #pragma once
 // Helpers of the end-to-end tests that run the ncfsim executable (NCFSIM_EXE, from the sources in
 // NCFSIM_SOURCE_DIR): spawn it with DISPLAY unset and its output in a log, read files back, read
-// history.csv by column name.
+// history.csv by column name, read a case's reference table (cases/<family>/reference/*.csv).
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -124,6 +127,66 @@ inline History read_history(const fs::path& file) {
     h.rows.push_back(std::move(v));
   }
   return h;
+}
+
+/// A reference table beside a case (cases/<family>/reference/<name>.csv): '#' lines (source,
+/// tolerance, what each column means), a header row, then rows whose first cell names the row (a
+/// quantity, or the x of a curve). An empty cell is NaN (no bound, no check).
+struct Reference {
+  fs::path file;
+  std::vector<std::string> columns;
+  std::vector<std::vector<std::string>> rows;
+  std::size_t column(const std::string& name) const {
+    const auto it = std::find(columns.begin(), columns.end(), name);
+    if (it == columns.end()) throw std::out_of_range(file.string() + ": no column '" + name + "'");
+    return static_cast<std::size_t>(it - columns.begin());
+  }
+  /// Cell of row r (0-based) in `col` as a number; NaN when empty.
+  double number(std::size_t r, const std::string& col) const {
+    const std::string& cell = rows.at(r).at(column(col));
+    return cell.empty() ? std::numeric_limits<double>::quiet_NaN() : std::stod(cell);
+  }
+  /// Cell `col` of the row whose first cell is `name`.
+  double at(const std::string& name, const std::string& col) const {
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      if (!rows[r].empty() && rows[r][0] == name) return number(r, col);
+    throw std::out_of_range(file.string() + ": no row '" + name + "'");
+  }
+};
+
+inline Reference read_reference(const fs::path& file) {
+  Reference t;
+  t.file = file;
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("cannot read " + file.string());
+  auto split = [](const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    if (!line.empty() && line.back() == ',') cells.emplace_back();
+    return cells;
+  };
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (t.columns.empty()) {
+      t.columns = split(line);
+      continue;
+    }
+    auto cells = split(line);
+    cells.resize(t.columns.size());
+    t.rows.push_back(std::move(cells));
+  }
+  return t;
+}
+
+/// cases/<family>/reference/<name>.csv of the sources.
+inline Reference case_reference(const std::string& family, const std::string& name) {
+  return read_reference(kSource / "cases" / family / "reference" / (name + ".csv"));
+}
+
+/// lower < value < upper for the bounds a reference row gives (NaN: no bound).
+inline bool within(double value, double lower, double upper) {
+  return (std::isnan(lower) || value > lower) && (std::isnan(upper) || value < upper);
 }
 
 }  // namespace ncfsim::test

@@ -354,10 +354,14 @@ TEST(CliRegression, PictureFrameForceRisesAtTheGapClosingAngle) {
     if (g > 4.0 && g < 12.5) before = std::max(before, std::abs(f));  // after the start-up ramp
     if (g > 27.5 && g < 28.5) at28 = f;
   }
+  const Reference ref = case_reference("drape", "picture_frame_unstitched");
   const double gap_closing = std::acos(3.22 / 3.32) * 180 / M_PI;
-  EXPECT_NEAR(gap_closing, 14.1, 0.1);
+  EXPECT_TRUE(within(gap_closing, ref.at("gap_closing_angle_deg", "lower"), ref.at("gap_closing_angle_deg", "upper")))
+      << gap_closing;
   EXPECT_GT(at28, 0.0);
-  EXPECT_LT(before, 0.01 * at28) << "the tows must rotate freely before their gaps close";
+  const double ratio = before / at28;
+  EXPECT_TRUE(within(ratio, std::nan(""), ref.at("force_before_gap_closing_over_force_at_28deg", "upper")))
+      << "the tows must rotate freely before their gaps close: " << ratio;
   fs::remove_all(out);
 }
 
@@ -379,7 +383,9 @@ nlohmann::json run_bias_extension(const std::string& sign) {
   fs::remove_all(out);
   return s;
 }
-void check_shear_against_eq2(const nlohmann::json& s) {
+// Against the case's reference curve (cases/drape/reference/bias_extension_<sign>.csv): Eq. 2 up to
+// 10 mm, below it beyond, the force bounds of the shear bias.
+void check_shear_against_eq2(const nlohmann::json& s, const std::string& sign) {
   EXPECT_EQ(s["status"], "completed");
   EXPECT_LT(s["energy_balance_error"].get<double>(), 0.01);
   // Erosion is there for a few folded tow ends at the clamp corners, not to carry a failing run.
@@ -391,27 +397,33 @@ void check_shear_against_eq2(const nlohmann::json& s) {
   if (s["eroded_elements"].get<int>() == 0) {
     EXPECT_EQ(fabric["stitch_connections_released"].get<int>(), 0);
   }
-  for (int d : {5, 10}) {
-    const std::string k = "_at_" + std::to_string(d) + "mm";
-    EXPECT_NEAR(s["shear_angle_deg" + k].get<double>(), s["analytic_shear_angle_deg" + k].get<double>(), 3.0) << d << " mm";
-  }
-  for (int d : {20, 30, 40}) {
-    const std::string k = "_at_" + std::to_string(d) + "mm";
-    EXPECT_LT(s["shear_angle_deg" + k].get<double>(), s["analytic_shear_angle_deg" + k].get<double>()) << d << " mm";
+  const Reference ref = case_reference("drape", "bias_extension_" + sign);
+  ASSERT_FALSE(ref.rows.empty());
+  for (std::size_t r = 0; r < ref.rows.size(); ++r) {
+    const std::string k = "_at_" + ref.rows[r][0] + "mm";
+    const double shear = s["shear_angle_deg" + k].get<double>(), eq2 = s["analytic_shear_angle_deg" + k].get<double>();
+    if (const double tol = ref.number(r, "eq2_tolerance_deg"); !std::isnan(tol)) {
+      EXPECT_NEAR(shear, eq2, tol) << ref.rows[r][0] << " mm";
+    }
+    if (ref.number(r, "below_eq2") == 1) {
+      EXPECT_LT(shear, eq2) << ref.rows[r][0] << " mm";
+    }
+    const double f_min = ref.number(r, "force_N_min"), f_max = ref.number(r, "force_N_max");
+    if (!std::isnan(f_min) || !std::isnan(f_max)) {
+      EXPECT_TRUE(within(s["force_N" + k].get<double>(), f_min, f_max))
+          << "force at " << ref.rows[r][0] << " mm: " << s["force_N" + k].get<double>() << " N";
+    }
   }
 }
 }  // namespace
 
 TEST(CliRegression, BiasExtensionPositiveShearFollowsEq2ThenSlips) {
-  const auto s = run_bias_extension("positive");
-  check_shear_against_eq2(s);
   // Pillar stitches stretch in positive shear: the force at 20 mm is well above the negative case's
   // (56 against 22 N at this resolution; the negative test checks its side of 30 N).
-  EXPECT_GT(s["force_N_at_20mm"].get<double>(), 40.0);
+  check_shear_against_eq2(run_bias_extension("positive"), "positive");
 }
 
 TEST(CliRegression, BiasExtensionNegativeShearFollowsEq2ThenSlips) {
-  const auto s = run_bias_extension("negative");
-  check_shear_against_eq2(s);
-  EXPECT_LT(s["force_N_at_20mm"].get<double>(), 30.0) << "negative shear: the pillars go slack";
+  // Negative shear: the pillars go slack (force at 20 mm below 30 N).
+  check_shear_against_eq2(run_bias_extension("negative"), "negative");
 }

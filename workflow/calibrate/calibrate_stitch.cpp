@@ -7,7 +7,7 @@
 
 #include "fem/errors.hpp"
 #include "render.hpp"
-#include "workflow/run/run_output.hpp"
+#include "workflow/output/output_files.hpp"
 
 namespace ncfsim::workflow {
 

@@ -8,7 +8,7 @@
 
 #include "fem/io/result_reader.hpp"
 #include "render.hpp"
-#include "workflow/run/run_output.hpp"
+#include "workflow/output/output_files.hpp"
 
 namespace ncfsim::workflow {
 

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "workflow/run/run_output.hpp"
+#include "workflow/output/output_files.hpp"
 
 namespace ncfsim::workflow {
 

@@ -1,0 +1,65 @@
+#pragma once
+// A quantity a run measures from the solver state and reports: its history.csv columns, its
+// values at a history row, its summary.json entries and its log lines. The time loop
+// (workflow/run) calls the measures of a case through this interface, in order; each module
+// implements its own (drape/probes: ply shear angle, ASTM D1388 bending length, picture-frame
+// force, bias-extension Eq. 2; workflow/run/run_measures: energies, tools, reactions, probes,
+// contact resultants). A measure reads the solver state, never changes it. Header only: the
+// libraries that implement a measure link nlohmann_json.
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "fem/solver.hpp"
+#include "fem/vec3.hpp"
+
+namespace ncfsim::fem {
+
+class RunMeasure {
+ public:
+  virtual ~RunMeasure() = default;
+
+  /// Log lines once the model is set up (what the measure found), in the run's log.
+  virtual std::vector<std::string> setup_lines() const { return {}; }
+  /// Appends its history.csv column names (units in the names). `columns` holds those of the
+  /// measures before it: a measure may look one up (its value is then in `row` at add_values).
+  /// Called once before the loop; bad input throws InputError.
+  virtual void add_columns(std::vector<std::string>& columns) { (void)columns; }
+  /// Columns that are only known once the solver has run a cycle (contact resultants): appended
+  /// once, at the first history row, after every measure's add_columns; so only the last
+  /// measures with columns may use it (values and columns must stay in the same order).
+  virtual void add_late_columns(const ExplicitSolver& s, std::vector<std::string>& columns) const {
+    (void)s, (void)columns;
+  }
+  /// Appends its values at a history row: one per column it added (add_columns, then
+  /// add_late_columns), in the same order. `row` holds the values of the measures before it.
+  virtual void add_values(const ExplicitSolver& s, std::vector<double>& row) const { (void)s, (void)row; }
+  /// After a cycle in which hexahedra were eroded (the erosions are logged before): warning lines
+  /// of what the measure saw change (e.g. stitch joints released).
+  virtual std::vector<std::string> after_erosion(const ExplicitSolver& s) { (void)s; return {}; }
+  /// Writes its summary.json entries at the solver's current state (called at every frame and
+  /// once at the end). A value that could not be measured is null.
+  virtual void add_summary(const ExplicitSolver& s, nlohmann::json& summary) const { (void)s, (void)summary; }
+};
+
+/// Mean displacement of a set of nodes at the solver's current state (m).
+inline V3 mean_displacement(const ExplicitSolver& s, const std::vector<std::int32_t>& nodes) {
+  auto X = s.x.view();
+  auto X0 = s.x0.view();
+  V3 sum;
+  for (auto i : nodes) {
+    const auto k = 3 * static_cast<std::size_t>(i);
+    sum += V3{X[k] - X0[k], X[k + 1] - X0[k + 1], X[k + 2] - X0[k + 2]};
+  }
+  return (1.0 / static_cast<double>(nodes.size())) * sum;
+}
+
+/// A JSON number, or null when not finite (a value that could not be measured).
+inline nlohmann::json json_number(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+}  // namespace ncfsim::fem

@@ -1,0 +1,48 @@
+#pragma once
+// The files of a run's output folder that the run writes and figures, report and calibration read
+// back: log (console + log.txt), atomic replacement (summary.json, figures.json, report.html),
+// history.csv and other numeric CSV. Shared by workflow/run, figures, report and calibrate, and
+// includes none of them (dependencies point one way: run -> figures/report -> output).
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <spdlog/logger.h>
+
+namespace ncfsim::workflow {
+
+enum class Verbosity { Quiet, Normal, Verbose };
+
+/// Console + log.txt logger; the same lines go to both (the console honours the verbosity).
+std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out_dir, Verbosity v);
+
+/// Writes text to `path` through a temporary file in the same folder, fsync and rename, so that a
+/// reader sees either the old or the new complete file.
+void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+
+/// history.csv: a header with named columns (units in the names), then one row per output time.
+/// Each row is flushed, so an interrupted run leaves only complete rows.
+class HistoryWriter {
+ public:
+  HistoryWriter(const std::filesystem::path& file, std::vector<std::string> columns);
+  void write_row(const std::vector<double>& values);
+  const std::vector<std::string>& columns() const { return columns_; }
+
+ private:
+  std::ofstream out_;
+  std::vector<std::string> columns_;
+};
+
+/// Reads a CSV written by HistoryWriter (or any numeric CSV with a header row).
+struct CsvTable {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+  /// Column values; throws std::out_of_range naming the column when absent.
+  std::vector<double> column(const std::string& name) const;
+};
+CsvTable read_csv(const std::filesystem::path& file);
+
+}  // namespace ncfsim::workflow

@@ -1,0 +1,127 @@
+#include "workflow/run/result_mesh.hpp"
+
+#include <limits>
+
+#include "fem/elements/element_fields.hpp"
+
+namespace ncfsim::workflow {
+
+fem::io::ResultMesh result_mesh(const fem::ExplicitSolver& s) {
+  const fem::Model& model = s.model();
+  const fem::Mesh& mesh = model.mesh;
+  fem::io::ResultMesh m;
+  m.points = mesh.coords;
+  m.part_names = mesh.part_names;
+  m.node_user_id = mesh.node_user_id;
+  for (const auto& mat : model.materials) m.material_names.push_back(mat->name());
+  for (const auto& law : model.bar_laws) m.bar_law_names.push_back(law.name());
+  const fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
+  const bool tagged = hexes.ply.size() == hexes.size() && hexes.tow.size() == hexes.size();
+  for (const auto& b : s.blocks<fem::Hex8Block>()) {
+    const int material = model.parts[static_cast<std::size_t>(b.part)].material;
+    for (std::size_t e = 0; e < b.n; ++e) {
+      for (int I = 0; I < 8; ++I) m.hex8.push_back(b.conn[static_cast<std::size_t>(I) * b.n + e]);
+      m.hex_part.push_back(b.part);
+      m.hex_user_id.push_back(b.user_id[e]);
+      m.hex_material.push_back(material);
+      const auto k = static_cast<std::size_t>(b.mesh_hex[e]);
+      m.hex_ply.push_back(tagged ? hexes.ply[k] : -1);
+      m.hex_tow.push_back(tagged ? hexes.tow[k] : -1);
+    }
+  }
+  for (const auto& b : s.blocks<fem::BarBlock>()) {
+    const int law = model.parts[static_cast<std::size_t>(b.part)].bar_law;
+    for (std::size_t e = 0; e < b.n; ++e) {
+      m.bar2.push_back(b.conn[e]);
+      m.bar2.push_back(b.conn[b.n + e]);
+      m.bar_part.push_back(b.part);
+      m.bar_user_id.push_back(b.user_id[e]);
+      m.bar_material.push_back(law);
+    }
+  }
+  return m;
+}
+
+fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
+  fem::io::Frame fr;
+  fr.time = s.time();
+  fr.cycle = static_cast<int>(s.cycle());
+  const std::size_t nn = s.model().mesh.n_nodes();
+  auto X = s.x.view();
+  auto X0 = s.x0.view();
+  auto Vv = s.v.view();
+  fr.displacement.resize(3 * nn);
+  for (std::size_t d = 0; d < 3 * nn; ++d) fr.displacement[d] = X[d] - X0[d];
+  fr.fields.push_back({"velocity", false, 3, std::vector<double>(Vv.data(), Vv.data() + 3 * nn)});
+  const std::size_t nh = s.n_elements(fem::ElementKind::Hex8), nb = s.n_elements(fem::ElementKind::Bar2);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  fem::io::FrameField stress{"stress", true, 6, std::vector<double>(6 * (nh + nb), nan)};
+  fem::io::FrameField vm{"von_mises_stress", true, 1, std::vector<double>(nh + nb, nan)};
+  fem::io::FrameField fibre{"fibre_direction", true, 3, std::vector<double>(3 * (nh + nb), nan)};
+  fem::io::FrameField axial{"axial_force", true, 1, std::vector<double>(nh + nb, nan)};
+  fem::io::FrameField bstrain{"axial_strain", true, 1, std::vector<double>(nh + nb, nan)};
+  std::size_t off = 0;
+  for (const auto& b : s.blocks<fem::Hex8Block>()) {
+    fem::hex8_output_fields(b, X.data(), stress.values.data() + 6 * off, vm.values.data() + off,
+                            fibre.values.data() + 3 * off);
+    off += b.n;
+  }
+  for (const auto& b : s.blocks<fem::BarBlock>()) {
+    for (std::size_t e = 0; e < b.n; ++e) {
+      axial.values[off + e] = b.force[e];
+      bstrain.values[off + e] = b.strain[e];
+    }
+    off += b.n;
+  }
+  if (nh) {
+    fr.fields.push_back(std::move(stress));
+    fr.fields.push_back(std::move(vm));
+    fr.fields.push_back(std::move(fibre));
+  }
+  if (nh && s.model().time.erosion_step_ratio > 0) {
+    // 1 where a hexahedron was eroded (ParaView: threshold it away)
+    fem::io::FrameField eroded{"eroded", true, 1, std::vector<double>(nh + nb, 0.0)};
+    std::size_t o = 0;
+    for (const auto& b : s.blocks<fem::Hex8Block>()) {
+      if (b.n_eroded)
+        for (std::size_t e = 0; e < b.n; ++e) eroded.values[o + e] = b.eroded[e];
+      o += b.n;
+    }
+    fr.fields.push_back(std::move(eroded));
+  }
+  if (nb) {
+    fr.fields.push_back(std::move(axial));
+    fr.fields.push_back(std::move(bstrain));
+  }
+  return fr;
+}
+
+fem::Mesh mesh_from_stage_frame(const fem::io::StageFrame& frame, bool deformed) {
+  const fem::io::ResultMesh& rm = frame.mesh;
+  fem::Mesh m;
+  m.coords = deformed ? frame.coordinates : rm.points;
+  m.part_names = rm.part_names;
+  const std::size_t nh = rm.n_hex(), nb = rm.n_bar();
+  m.node_user_id = rm.node_user_id;
+  if (nh) {
+    fem::ElementSet& hexes = m.elements(fem::ElementKind::Hex8);
+    for (std::size_t e = 0; e < nh; ++e) {
+      std::int32_t n[8];
+      for (std::size_t I = 0; I < 8; ++I) n[I] = static_cast<std::int32_t>(rm.hex8[8 * e + I]);
+      hexes.add(std::span<const std::int32_t>(n, 8), rm.hex_part[e]);
+    }
+    hexes.user_id = rm.hex_user_id;
+    hexes.ply = rm.hex_ply;
+    hexes.tow = rm.hex_tow;
+  }
+  if (nb) {
+    fem::ElementSet& bars = m.elements(fem::ElementKind::Bar2);
+    for (std::size_t e = 0; e < nb; ++e)
+      bars.add({static_cast<std::int32_t>(rm.bar2[2 * e]), static_cast<std::int32_t>(rm.bar2[2 * e + 1])}, rm.bar_part[e]);
+    bars.user_id = rm.bar_user_id;
+  }
+  m.fill_default_user_ids();  // whatever the file did not hold
+  return m;
+}
+
+}  // namespace ncfsim::workflow

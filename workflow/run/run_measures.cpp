@@ -1,0 +1,167 @@
+#include "workflow/run/run_measures.hpp"
+
+#include <fmt/format.h>
+
+#include "drape/probes/bending_length_probe.hpp"
+#include "drape/probes/bias_extension_curve.hpp"
+#include "drape/probes/fabric_report.hpp"
+#include "drape/probes/picture_frame_force.hpp"
+#include "drape/probes/shear_angle_probe.hpp"
+
+namespace ncfsim::workflow {
+
+using fem::V3;
+
+fem::V3 tool_axis(const fem::RigidTool& t) {
+  if (t.motion.kind == fem::ToolMotion::Kind::Velocity && norm(t.motion.velocity) > 0) return normalized(t.motion.velocity);
+  if (t.motion.kind == fem::ToolMotion::Kind::Force) return t.motion.axis;
+  return t.surface.axis;
+}
+
+std::string sample_suffix(double at, const std::string& unit) { return fmt::format("_at_{:g}{}", at, unit); }
+
+namespace {
+
+void add_xyz(std::vector<std::string>& columns, const std::string& prefix, const std::string& unit) {
+  for (const char* c : {"x", "y", "z"}) columns.push_back(prefix + "_" + c + "_" + unit);
+}
+
+// time, cycle, step and the energy balance (+ erosion counts when erosion is on).
+class EnergyColumns final : public fem::RunMeasure {
+ public:
+  explicit EnergyColumns(bool erosion) : erosion_(erosion) {}
+  void add_columns(std::vector<std::string>& c) override {
+    for (const char* n : {"time", "cycle", "time_step_s", "kinetic_energy_J", "internal_energy_J",
+                          "stabilisation_energy_J", "hourglass_energy_J", "contact_energy_J", "friction_energy_J",
+                          "damping_energy_J", "external_work_J", "total_energy_J", "energy_balance_error"})
+      c.push_back(n);
+    if (erosion_) {
+      c.push_back("eroded_elements");
+      c.push_back("eroded_internal_energy_J");
+    }
+  }
+  void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override {
+    const auto& en = s.energy();
+    for (double v : {s.time(), static_cast<double>(s.cycle()), s.time_step(), en.kinetic, en.internal,
+                     en.stabilisation, en.hourglass, en.contact, en.friction, en.damping, en.external_work,
+                     en.total(), en.error()})
+      row.push_back(v);
+    if (erosion_) {
+      row.push_back(static_cast<double>(s.erosions().size()));
+      row.push_back(en.eroded_internal);
+    }
+  }
+
+ private:
+  bool erosion_;
+};
+
+// Rigid tools: force (resistance of the part, positive against the motion) and displacement
+// along the motion axis, and their components.
+class ToolMeasure final : public fem::RunMeasure {
+ public:
+  explicit ToolMeasure(const fem::RigidTool& t) : tool_(t) {}
+  void add_columns(std::vector<std::string>& c) override {
+    c.push_back(tool_.name + "_force_N");
+    c.push_back(tool_.name + "_displacement_m");
+    add_xyz(c, tool_.name + "_force", "N");
+    add_xyz(c, tool_.name + "_displacement", "m");
+  }
+  void add_values(const fem::ExplicitSolver&, std::vector<double>& row) const override {
+    const V3 ax = tool_axis(tool_);
+    row.push_back(-dot(tool_.force, ax));  // resistance of the part, positive against the motion
+    row.push_back(dot(tool_.displacement, ax));
+    for (double v : tool_.force.arr()) row.push_back(v);
+    for (double v : tool_.displacement.arr()) row.push_back(v);
+  }
+  void add_summary(const fem::ExplicitSolver&, nlohmann::json& summary) const override {
+    summary[tool_.name + "_force_N"] = -dot(tool_.force, tool_axis(tool_));
+    summary[tool_.name + "_displacement_m"] = dot(tool_.displacement, tool_axis(tool_));
+  }
+
+ private:
+  const fem::RigidTool& tool_;  // borrowed from the model
+};
+
+// Reaction of a fixed or velocity set.
+class ReactionMeasure final : public fem::RunMeasure {
+ public:
+  explicit ReactionMeasure(const ReactionProbe& r) : r_(r) {}
+  void add_columns(std::vector<std::string>& c) override { add_xyz(c, r_.name + "_reaction", "N"); }
+  void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override {
+    for (double v : s.reaction_force(r_.nodes).arr()) row.push_back(v);
+  }
+
+ private:
+  ReactionProbe r_;
+};
+
+// Mean displacement of a node set.
+class DisplacementMeasure final : public fem::RunMeasure {
+ public:
+  explicit DisplacementMeasure(const DisplacementProbe& p) : p_(p) {}
+  void add_columns(std::vector<std::string>& c) override { add_xyz(c, p_.name + "_displacement", "m"); }
+  void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override {
+    for (double v : fem::mean_displacement(s, p_.nodes).arr()) row.push_back(v);
+  }
+  void add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const override {
+    const V3 d = fem::mean_displacement(s, p_.nodes);
+    summary[p_.name + "_displacement_m"] = {d.x, d.y, d.z};
+  }
+
+ private:
+  DisplacementProbe p_;
+};
+
+// Force resultants of the deformable contacts, named by the contacts once they have run a cycle.
+class ContactResultants final : public fem::RunMeasure {
+ public:
+  void add_late_columns(const fem::ExplicitSolver& s, std::vector<std::string>& c) const override {
+    for (const auto& contact : s.model().contacts)
+      for (const auto& r : contact->resultants()) add_xyz(c, r.name + "_force", "N");
+  }
+  void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override {
+    for (const auto& contact : s.model().contacts)
+      for (const auto& r : contact->resultants())
+        for (double v : r.force.arr()) row.push_back(v);
+  }
+};
+
+// The bias-extension curve (Eq. 2) of the case's summary samples that ask for it: the history
+// column follows the last of them.
+std::unique_ptr<fem::RunMeasure> make_bias_extension_curve(const EngineCase& ec) {
+  const SummarySamples* analytic = nullptr;
+  std::vector<drape::BiasExtensionCurve::Point> points;
+  for (const auto& ss : ec.samples) {
+    if (!ss.bias_extension_analytic) continue;
+    analytic = &ss;
+    drape::BiasExtensionCoupon coupon;
+    coupon.length = ss.coupon_length, coupon.width = ss.coupon_width;
+    for (double at : ss.at) points.push_back({sample_suffix(at, ss.x_unit), at / ss.x_display_scale, coupon});
+  }
+  if (!analytic) return nullptr;
+  drape::BiasExtensionCoupon coupon;
+  coupon.length = analytic->coupon_length, coupon.width = analytic->coupon_width;
+  return std::make_unique<drape::BiasExtensionCurve>(analytic->x, coupon, std::move(points), ec.file.string());
+}
+
+}  // namespace
+
+MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s) {
+  const fem::Model& model = s.model();
+  MeasureList m;
+  m.push_back(std::make_unique<EnergyColumns>(model.time.erosion_step_ratio > 0));
+  for (const auto& t : model.tools) m.push_back(std::make_unique<ToolMeasure>(t));
+  for (const auto& r : ec.reactions) m.push_back(std::make_unique<ReactionMeasure>(r));
+  for (std::size_t k = 0; k < model.picture_frames.size(); ++k)
+    m.push_back(std::make_unique<drape::PictureFrameForce>(k, model.picture_frames[k], ec.frame_fabric_length[k]));
+  for (const auto& p : ec.probes) m.push_back(std::make_unique<DisplacementMeasure>(p));
+  for (const auto& sp : ec.shear_probes) m.push_back(std::make_unique<drape::ShearAngleProbe>(sp, s, ec.file.string()));
+  for (const auto& bp : ec.bending) m.push_back(std::make_unique<drape::BendingLengthMeasure>(bp, s));
+  if (auto curve = make_bias_extension_curve(ec)) m.push_back(std::move(curve));
+  m.push_back(std::make_unique<ContactResultants>());
+  if (!ec.fabric_summaries.empty()) m.push_back(std::make_unique<drape::FabricReport>(ec.fabric_summaries, model));
+  return m;
+}
+
+}  // namespace ncfsim::workflow

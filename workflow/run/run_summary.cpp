@@ -1,0 +1,128 @@
+#include "workflow/run/run_summary.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "workflow/run/engine_run.hpp"
+#include "workflow/run/run_measures.hpp"
+#include "workflow/version.hpp"
+
+namespace ncfsim::workflow {
+
+using json = nlohmann::json;
+
+json summary_header(const EngineCase& ec, const RunOptions& options) {
+  json summary;
+  summary["case"] = ec.name;
+  summary["stage"] = "engine";
+  summary["ncfsim_version"] = kVersion;
+  summary["case_file"] = ec.file.string();
+  summary["overrides"] = options.overrides;
+  summary["resolution"] = ec.resolution;
+  summary["status"] = "starting";
+  return summary;
+}
+
+void describe_model(const fem::ExplicitSolver& solver, spdlog::logger& log, json& summary) {
+  const fem::Model& model = solver.model();
+  log.info("mesh: {} nodes, {} hexahedra, {} bars, {} parts, {} tools", model.mesh.n_nodes(), solver.n_elements(fem::ElementKind::Hex8),
+           solver.n_elements(fem::ElementKind::Bar2), model.mesh.part_names.size(), model.tools.size());
+  const auto& st = solver.controlling_element();
+  log.info("stable step {:.4g} s (safety factor {}), controlled by {} {}", solver.time_step(),
+           model.time.safety_factor, fem::element_noun(st.kind), st.element);
+  json parts = json::object();
+  for (const auto& pm : solver.part_masses()) {
+    const double pct = pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0;
+    log.info("  part {:<16} mass {:.5g} kg, added by mass scaling {:.5g} kg ({:.3g} %)", pm.part, pm.mass,
+             pm.added_mass, pct);
+    parts[pm.part] = {{"mass_kg", pm.mass}, {"added_mass_kg", pm.added_mass}, {"added_mass_percent", pct}};
+  }
+  log.info("end time {:.4g} s: about {:.3g} cycles", model.time.end_time, model.time.end_time / solver.time_step());
+  summary["elements"] = {{"hex8", solver.n_elements(fem::ElementKind::Hex8)}, {"bar2", solver.n_elements(fem::ElementKind::Bar2)}};
+  summary["nodes"] = model.mesh.n_nodes();
+  summary["parts"] = parts;
+  summary["end_time_s"] = model.time.end_time;
+  summary["time_step_initial_s"] = solver.time_step();
+  summary["energy_balance_limit"] = model.time.energy_balance_limit;
+}
+
+void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json& summary) {
+  const auto& en = solver.energy();
+  summary["cycles"] = solver.cycle();
+  summary["time_reached_s"] = solver.time();
+  summary["time_step_final_s"] = solver.time_step();
+  summary["energy_balance_error"] = en.error();
+  summary["energy_balance_error_max"] = max_error;
+  summary["kinetic_energy_J"] = en.kinetic;
+  summary["internal_energy_J"] = en.internal;
+  summary["stabilisation_energy_J"] = en.stabilisation;
+  summary["hourglass_energy_J"] = en.hourglass;
+  summary["contact_energy_J"] = en.contact;
+  summary["friction_energy_J"] = en.friction;
+  summary["damping_energy_J"] = en.damping;
+  summary["external_work_J"] = en.external_work;
+  summary["hourglass_to_internal_ratio"] = en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
+  summary["eroded_elements"] = solver.erosions().size();
+  summary["eroded_internal_energy_J"] = en.eroded_internal;
+  const auto& tm = solver.timers();
+  summary["timers_s"] = {{"internal_force", tm.internal_force}, {"contact", tm.contact},
+                         {"update", tm.update}, {"output", tm.output}};
+}
+
+namespace {
+
+// Mean of a column over a time window (or the ratio of two columns' increments over it).
+void add_mean(const SummaryMean& sm, const RunHistory& h, json& summary) {
+  const int c = h.index(sm.column), cp = h.index(sm.per_column);
+  const auto col = [](const std::vector<double>& r, int k) { return r[static_cast<std::size_t>(k)]; };
+  double sum = 0;
+  std::size_t n = 0;
+  const std::vector<double>*first = nullptr, *last = nullptr;
+  for (const auto& r : h.rows())
+    if (c >= 0 && r[0] >= sm.from_time && r[0] <= sm.to_time) {
+      sum += col(r, c), ++n;
+      if (!first) first = &r;
+      last = &r;
+    }
+  double value = n ? sm.scale * sum / static_cast<double>(n) : std::nan("");
+  if (!sm.per_column.empty()) {  // ratio of increments over the window
+    value = std::nan("");
+    if (cp >= 0 && first && last && col(*last, cp) != col(*first, cp))
+      value = sm.scale * (col(*last, c) - col(*first, c)) / (col(*last, cp) - col(*first, cp));
+  }
+  summary[sm.name] = fem::json_number(value);
+  if ((c < 0 || (!sm.per_column.empty() && cp < 0)) && !h.columns().empty())
+    summary[sm.name + "_error"] = "no history column '" + (c < 0 ? sm.column : sm.per_column) + "'";
+}
+
+// History columns interpolated at given values of another column.
+void add_samples(const SummarySamples& ss, const RunHistory& h, json& summary) {
+  const auto& rows = h.rows();
+  const int cx = h.index(ss.x);
+  for (double at : ss.at) {
+    const std::string tag = sample_suffix(at, ss.x_unit);
+    const double xv = at / ss.x_display_scale;
+    for (const auto& [label, column] : ss.columns) {
+      const int cy = h.index(column);
+      double val = std::numeric_limits<double>::quiet_NaN();
+      for (std::size_t r = 1; cx >= 0 && cy >= 0 && r < rows.size(); ++r) {
+        const double x0 = rows[r - 1][static_cast<std::size_t>(cx)], x1 = rows[r][static_cast<std::size_t>(cx)];
+        if ((x0 - xv) * (x1 - xv) <= 0 && x1 != x0) {
+          const double w = (xv - x0) / (x1 - x0);
+          val = (1 - w) * rows[r - 1][static_cast<std::size_t>(cy)] + w * rows[r][static_cast<std::size_t>(cy)];
+          break;
+        }
+      }
+      summary[label + tag] = fem::json_number(val);
+    }
+  }
+}
+
+}  // namespace
+
+void add_history_summary(const EngineCase& ec, const RunHistory& history, json& summary) {
+  for (const auto& sm : ec.means) add_mean(sm, history, summary);
+  for (const auto& ss : ec.samples) add_samples(ss, history, summary);
+}
+
+}  // namespace ncfsim::workflow

@@ -1,0 +1,30 @@
+#pragma once
+// summary.json of a run (docs/output.md): the header, the model, the state at a frame and at the
+// end (energies, erosion, timers), and the summary samples and means over the history rows. The
+// measures add their own entries (fem/run_measure.hpp).
+#include <nlohmann/json.hpp>
+#include <spdlog/logger.h>
+
+#include "fem/solver.hpp"
+#include "workflow/case/engine_case.hpp"
+#include "workflow/run/run_history.hpp"
+
+namespace ncfsim::workflow {
+
+struct RunOptions;
+
+/// case, stage, ncfsim_version, case_file, overrides, resolution, status = "starting".
+nlohmann::json summary_header(const EngineCase& ec, const RunOptions& options);
+
+/// Logs the model (mesh, stable step, part masses, end time) and writes elements, nodes, parts,
+/// end_time_s, time_step_initial_s, energy_balance_limit.
+void describe_model(const fem::ExplicitSolver& s, spdlog::logger& log, nlohmann::json& summary);
+
+/// cycles, time reached, steps, the energy balance and its terms, hourglass ratio, erosion, timers.
+void add_state_summary(const fem::ExplicitSolver& s, double energy_balance_error_max, nlohmann::json& summary);
+
+/// The case's [[output.mean]] and [[output.sample]] values over the kept history rows (null where
+/// they cannot be measured).
+void add_history_summary(const EngineCase& ec, const RunHistory& history, nlohmann::json& summary);
+
+}  // namespace ncfsim::workflow

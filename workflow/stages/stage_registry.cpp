@@ -1,0 +1,71 @@
+#include "workflow/stages/stage_registry.hpp"
+
+#include <cstdio>
+
+#include "fem/errors.hpp"
+#include "fem/petsc_vector.hpp"
+#include "fem/case/toml_reader.hpp"
+
+namespace ncfsim::workflow {
+
+namespace {
+
+int run_engine_stage(const StageCall& call) {
+  EngineCase ec = load_engine_case(call.case_file, call.overrides);
+  fem::PetscSession petsc;  // after the case: bad input is reported without starting MPI
+  if (const int code = refuse_many_ranks()) return code;
+  return run_engine_case(ec, call.options);
+}
+
+}  // namespace
+
+int refuse_many_ranks() {
+  const int n = fem::PetscSession::size();
+  if (n <= 1) return 0;
+  if (fem::PetscSession::rank() == 0)
+    std::fprintf(stderr,
+                 "ncfsim: bad input: started on %d MPI ranks, but the domain decomposition is not "
+                 "implemented yet (each rank would run the whole model and write the same files): "
+                 "start ncfsim without mpirun/mpiexec (one rank)\n",
+                 n);
+  return kBadInput;
+}
+
+const std::vector<Stage>& stages() {
+  static const std::vector<Stage> registry{
+      {"engine", "explicit finite-element run (virtual tests, forming, crush)", &run_engine_stage},
+  };
+  return registry;
+}
+
+const std::vector<std::string>& planned_stage_kinds() {
+  static const std::vector<std::string> planned{"kinematic_drape", "transfer", "crush", "workflow"};
+  return planned;
+}
+
+const Stage& find_stage(const std::string& kind, const std::filesystem::path& file) {
+  for (const auto& s : stages())
+    if (s.kind == kind) return s;
+  std::string allowed;
+  for (const auto& s : stages()) allowed += (allowed.empty() ? "" : ", ") + s.kind;
+  std::string planned;
+  for (const auto& p : planned_stage_kinds()) planned += (planned.empty() ? "" : ", ") + p;
+  throw InputError(file.string(), "case.kind",
+                   "'" + kind + "' is not a stage kind; allowed: " + allowed + " (planned, not in this build: " +
+                       planned + ")");
+}
+
+std::string case_kind(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  const fem::CaseDocument doc = fem::CaseDocument::load(file, overrides);
+  const auto* c = doc.root()["case"].as_table();
+  if (!c || !c->contains("kind")) return "engine";
+  const auto kind = (*c)["kind"].value<std::string>();
+  if (!kind) throw InputError(file.string(), "case.kind", "must be a string (allowed: a stage kind, e.g. engine)");
+  return *kind;
+}
+
+int run_stage(const StageCall& call) {
+  return find_stage(case_kind(call.case_file, call.overrides), call.case_file).run(call);
+}
+
+}  // namespace ncfsim::workflow

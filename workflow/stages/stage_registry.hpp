@@ -1,0 +1,49 @@
+#pragma once
+// `[case] kind` -> the stage that runs it. Today one stage, "engine" (any explicit model:
+// virtual tests, forming, crush); kinematic_drape, transfer, crush and workflow register here as
+// their issues land (docs/architecture-stages.md). A stage reads its own case file (its module's
+// reader), runs into the output folder and returns the exit code of the command line; it hands the
+// next stage its results.h5 (fem/io/stage_handoff.hpp).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "workflow/run/engine_run.hpp"
+
+namespace ncfsim::workflow {
+
+/// What `ncfsim run` passes a stage.
+struct StageCall {
+  std::filesystem::path case_file;
+  std::vector<std::string> overrides;  // --set items
+  RunOptions options;
+};
+
+struct Stage {
+  std::string kind;         // the [case] kind value
+  std::string description;  // one line, for messages and --help
+  /// Reads the case, runs it; returns the exit code (ExitCode). Bad input throws InputError.
+  int (*run)(const StageCall& call) = nullptr;
+};
+
+/// The registered stages, in the order they are listed in messages.
+const std::vector<Stage>& stages();
+/// Kinds that are planned but not yet built (named in the error for an unknown kind).
+const std::vector<std::string>& planned_stage_kinds();
+
+/// The stage of `kind`; throws InputError(file, "case.kind") listing the allowed kinds.
+const Stage& find_stage(const std::string& kind, const std::filesystem::path& file = {});
+
+/// `[case] kind` of a case file after the overrides ("engine" when absent). Throws InputError for
+/// a file that does not parse or a kind that is not a string.
+std::string case_kind(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+
+/// Looks the case's kind up and runs its stage.
+int run_stage(const StageCall& call);
+
+/// Until the domain decomposition lands the engine runs on one MPI rank: started by mpirun on
+/// more, every rank would run the whole model and write the same files. Returns the exit code
+/// (0: one rank); rank 0 says why. Needs an active PetscSession.
+int refuse_many_ranks();
+
+}  // namespace ncfsim::workflow
