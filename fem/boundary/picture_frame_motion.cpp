@@ -27,12 +27,14 @@ PictureFrameMotion::PictureFrameMotion(const std::vector<PictureFrame>& frames) 
 
 void PictureFrameMotion::check(std::size_t n) const {
   for (const auto& pf : frames_)
-    if (!(std::abs(dot(pf.arm1, pf.arm1) - 1) < 1e-9 && std::abs(dot(pf.arm2, pf.arm2) - 1) < 1e-9 &&
-          std::abs(dot(pf.arm1, pf.arm2)) < 1e-9))
-      throw InputError("", "boundary.picture_frame." + pf.name, "the arms must be orthogonal unit vectors");
+    if (!(std::abs(dot(pf.arm1, pf.arm1) - 1) < 1e-9 &&
+          std::abs(dot(pf.arm2, pf.arm2) - 1) < 1e-9 && std::abs(dot(pf.arm1, pf.arm2)) < 1e-9))
+      throw InputError("", "boundary.picture_frame." + pf.name,
+                       "the arms must be orthogonal unit vectors");
   for (const auto& pf : frames_) {
     if (!(pf.wall_penalty_scale > 0 && pf.wall_penalty_scale <= 1))
-      throw InputError("", "boundary.picture_frame." + pf.name + ".wall_penalty_scale", "must be in (0, 1]");
+      throw InputError("", "boundary.picture_frame." + pf.name + ".wall_penalty_scale",
+                       "must be in (0, 1]");
     for (const auto& w : pf.walls)
       for (auto node : w)
         if (node < 0 || static_cast<std::size_t>(node) >= n)
@@ -61,7 +63,8 @@ void PictureFrameMotion::velocities(double t, double* v) {
   }
 }
 
-void PictureFrameMotion::add_forces(double t, const double* x, const double* mass, double dt, double* fc) {
+void PictureFrameMotion::add_forces(double t, const double* x, const double* mass, double dt,
+                                    double* fc) {
   wall_contacts_.clear();
   const double inv_dt2 = 1.0 / (dt * dt);
   for (std::size_t k = 0; k < frames_.size(); ++k) {
@@ -85,9 +88,12 @@ void PictureFrameMotion::add_forces(double t, const double* x, const double* mas
         if (along < 0 || along > L) continue;  // the arms are bars from pin to pin
         const double d_lo = q * c, d_hi = (L - q) * c;
         double depth = 0, sign = 0;
-        if (d_lo < 0) depth = -d_lo, sign = 1;
-        else if (d_hi < 0) depth = -d_hi, sign = -1;
-        else continue;
+        if (d_lo < 0)
+          depth = -d_lo, sign = 1;
+        else if (d_hi < 0)
+          depth = -d_hi, sign = -1;
+        else
+          continue;
         const double k_pen = pf.wall_penalty_scale * mass[3 * i] * inv_dt2;
         const V3 F = (sign * k_pen * depth) * (w == 0 ? n1 : n2);
         fc[3 * i] += F.x, fc[3 * i + 1] += F.y, fc[3 * i + 2] += F.z;

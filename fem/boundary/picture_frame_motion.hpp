@@ -28,12 +28,14 @@ class PictureFrameMotion final : public BoundaryMotion {
   /// Power (W) the walls of frame k put into the nodes at t^{n+1/2} of the last cycle.
   double wall_power(std::size_t k) const { return k < wall_power_.size() ? wall_power_[k] : 0.0; }
   /// Nodes in contact with the walls of frame k in the last cycle.
-  std::int64_t wall_contacts(std::size_t k) const { return k < wall_active_.size() ? wall_active_[k] : 0; }
+  std::int64_t wall_contacts(std::size_t k) const {
+    return k < wall_active_.size() ? wall_active_[k] : 0;
+  }
 
  private:
   const std::vector<PictureFrame>& frames_;
   struct FrameDof {
-    std::size_t k = 0;            // the solver's constrained DOF
+    std::size_t k = 0;  // the solver's constrained DOF
     std::int32_t frame = -1;
     std::uint8_t component = 0;
     double xi = 0, eta = 0;  // reference coordinates along the frame's arms

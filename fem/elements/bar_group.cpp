@@ -48,7 +48,8 @@ class BarGroup final : public ElementGroup {
     return {{"axial_force", 1}, {"axial_strain", 1}};
   }
   void cell_values(const double*, double* const* out) const override {
-    for (std::size_t e = 0; e < block.n; ++e) out[0][e] = block.force[e], out[1][e] = block.strain[e];
+    for (std::size_t e = 0; e < block.n; ++e)
+      out[0][e] = block.force[e], out[1][e] = block.strain[e];
   }
 };
 
@@ -59,7 +60,8 @@ std::unique_ptr<ElementGroup> make_bar2_group(const Model& model, const ElementS
                                               const double* x_ref) {
   const PartProperties& pp = model.parts[static_cast<std::size_t>(part)];
   if (pp.bar_law < 0 || static_cast<std::size_t>(pp.bar_law) >= model.bar_laws.size())
-    throw InputError("", "part." + model.mesh.part_names[static_cast<std::size_t>(part)] + ".bar_law",
+    throw InputError("",
+                     "part." + model.mesh.part_names[static_cast<std::size_t>(part)] + ".bar_law",
                      "no such bar law");
   auto g = std::make_unique<BarGroup>();
   BarBlock& b = g->block;

@@ -93,8 +93,8 @@ class ElementGroup {
 /// The elements `elements` (indices into `set`) of part `part`, as a group of the set's kind, set
 /// up at reference positions x_ref. Throws InputError naming the part when its properties do not
 /// fit the kind (no material, no bar law), NumericalError for a degenerate element.
-std::unique_ptr<ElementGroup> make_element_group(const Model& model, const ElementSet& set, int part,
-                                                 const std::vector<std::size_t>& elements,
+std::unique_ptr<ElementGroup> make_element_group(const Model& model, const ElementSet& set,
+                                                 int part, const std::vector<std::size_t>& elements,
                                                  const double* x_ref);
 
 /// The block of kind Block behind a group, null when the group is of another kind.

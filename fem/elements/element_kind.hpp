@@ -34,7 +34,8 @@ constexpr const char* element_kind_name(ElementKind k) {
 constexpr bool element_needs_distinct_nodes(ElementKind k) { return nodes_per_element(k) == 2; }
 
 /// A quadrilateral face of a solid element: corners (local node numbers) counter-clockwise seen
-/// from outside, and the face opposite it (its distance is the element's thickness behind the face).
+/// from outside, and the face opposite it (its distance is the element's thickness behind the
+/// face).
 struct ElementFace {
   std::array<int, 4> corner;
   int opposite;

@@ -66,7 +66,8 @@ std::unique_ptr<ElementGroup> make_hex8_group(const Model& model, const ElementS
                                               const double* x_ref) {
   const PartProperties& pp = model.parts[static_cast<std::size_t>(part)];
   if (pp.material < 0 || static_cast<std::size_t>(pp.material) >= model.materials.size())
-    throw InputError("", "part." + model.mesh.part_names[static_cast<std::size_t>(part)] + ".material",
+    throw InputError("",
+                     "part." + model.mesh.part_names[static_cast<std::size_t>(part)] + ".material",
                      "no such material");
   auto g = std::make_unique<Hex8Group>();
   Hex8Block& b = g->block;

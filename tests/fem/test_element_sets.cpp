@@ -66,7 +66,8 @@ TEST(ElementSets, RenumberingKeepsTagsAndIdsWithTheirElement) {
       for (std::size_t k = 0; k < 3; ++k) c[k] += m.coords[3 * static_cast<std::size_t>(v) + k] / 8;
     return c;
   };
-  for (std::size_t e = 0; e < hexes.size(); ++e) centre_of_id[static_cast<std::size_t>(hexes.user_id[e])] = centre(e);
+  for (std::size_t e = 0; e < hexes.size(); ++e)
+    centre_of_id[static_cast<std::size_t>(hexes.user_id[e])] = centre(e);
   fem::renumber_for_locality(m);
   for (const auto& s : m.sets)
     for (std::size_t e = 0; e < s.size(); ++e) {
@@ -84,7 +85,8 @@ TEST(ElementSets, RenumberingKeepsTagsAndIdsWithTheirElement) {
 
 TEST(ElementGroups, OneGroupPerKindAndPartInKindOrderWithTheKernelsFields) {
   fem::Model model = block_and_bars();
-  model.initial_velocities.push_back({test::nodes_at(model.mesh, 0, 0.03), {1.0, 0, 0.5}});  // stretch
+  model.initial_velocities.push_back(
+      {test::nodes_at(model.mesh, 0, 0.03), {1.0, 0, 0.5}});  // stretch
   fem::ExplicitSolver solver(model);
   const auto& groups = solver.groups();
   ASSERT_EQ(groups.size(), 2u);
@@ -122,7 +124,8 @@ TEST(ElementGroups, OneGroupPerKindAndPartInKindOrderWithTheKernelsFields) {
 
 TEST(ElementGroups, APartHoldingTwoKindsIsRefused) {
   fem::Model model = block_and_bars();
-  for (auto& p : model.mesh.elements(fem::ElementKind::Bar2).part) p = model.mesh.find_part("block");
+  for (auto& p : model.mesh.elements(fem::ElementKind::Bar2).part)
+    p = model.mesh.find_part("block");
   try {
     fem::ExplicitSolver solver(model);
     FAIL() << "no error";
