@@ -68,16 +68,8 @@ void TowMaterial::update_stress(const fem::MaterialBatch& b) const {
   double* __restrict E = b.history;  // total Green-Lagrange strain [6][stride]
   const fem::Voigt6x6& C = C_;
   for (std::size_t e = 0; e < b.n; ++e) {
-    double Ev[6];
-    for (int k = 0; k < 6; ++k) {
-      E[k * s + e] += de[k * t + e];
-      Ev[k] = E[k * s + e];
-    }
-    double S[6];
-    for (int i = 0; i < 3; ++i) S[i] = C[6 * i] * Ev[0] + C[6 * i + 1] * Ev[1] + C[6 * i + 2] * Ev[2];
-    S[3] = C[21] * Ev[3];
-    S[4] = C[28] * Ev[4];
-    S[5] = C[35] * Ev[5];
+    double Ev[6], S[6];
+    fem::accumulate_strain_orthotropic_stress(C, de, t, E, s, e, Ev, S);
     add_compaction_stress(Ev, S);
     for (int k = 0; k < 6; ++k) sig[k * s + e] = S[k];
   }

@@ -14,12 +14,12 @@ namespace ncfsim::fem {
 using Voigt6x6 = std::array<double, 36>;  // row-major
 
 struct MaterialBatch {
-  std::size_t n = 0;             // elements in the batch
-  std::size_t stride = 0;        // distance between components of stress and history
-  std::size_t strain_stride = 0; // distance between components of strain_increment
+  std::size_t n = 0;                         // elements in the batch
+  std::size_t stride = 0;                    // distance between components of stress and history
+  std::size_t strain_stride = 0;             // distance between components of strain_increment
   const double* strain_increment = nullptr;  // [6][strain_stride], material frame, borrowed
-  double* stress = nullptr;      // [6][stride], material frame, updated in place
-  double* history = nullptr;     // [n_history][stride], updated in place
+  double* stress = nullptr;                  // [6][stride], material frame, updated in place
+  double* history = nullptr;                 // [n_history][stride], updated in place
   // [3][stride] reference element lengths along the material axes (m), borrowed; null where the
   // caller has none. Damage laws regularise their softening with them (crack band).
   const double* length = nullptr;
@@ -79,6 +79,23 @@ class ElasticOrthotropic final : public SolidMaterial {
   double rho_;
   Voigt6x6 C_{};
 };
+
+/// One element of a batch whose law is a function of the total Green-Lagrange strain kept in the
+/// first six history rows: adds the increment to it (E [6], out) and gives the orthotropic stress
+/// C E (S [6]; C has no normal-shear coupling, as every law here in the material frame).
+inline void accumulate_strain_orthotropic_stress(const Voigt6x6& C, const double* __restrict de,
+                                                 std::size_t t, double* __restrict history,
+                                                 std::size_t s, std::size_t e, double E[6],
+                                                 double S[6]) {
+  for (int k = 0; k < 6; ++k) {
+    history[k * s + e] += de[k * t + e];
+    E[k] = history[k * s + e];
+  }
+  for (int i = 0; i < 3; ++i) S[i] = C[6 * i] * E[0] + C[6 * i + 1] * E[1] + C[6 * i + 2] * E[2];
+  S[3] = C[21] * E[3];
+  S[4] = C[28] * E[4];
+  S[5] = C[35] * E[5];
+}
 
 /// Stiffness from engineering constants; throws std::invalid_argument if not positive definite.
 Voigt6x6 orthotropic_stiffness(const OrthotropicConstants& c);

@@ -53,17 +53,8 @@ void TowDamageMaterial::update_stress(const fem::MaterialBatch& b) const {
   const fem::Voigt6x6& C = C_;
   const double L0 = c_.default_length;
   for (std::size_t e = 0; e < b.n; ++e) {
-    double E[6];
-    for (int k = 0; k < 6; ++k) {
-      h[k * s + e] += de[k * t + e];
-      E[k] = h[k * s + e];
-    }
-    // Effective (undamaged) stress.
-    double S[6];
-    for (int i = 0; i < 3; ++i) S[i] = C[6 * i] * E[0] + C[6 * i + 1] * E[1] + C[6 * i + 2] * E[2];
-    S[3] = C[21] * E[3];
-    S[4] = C[28] * E[4];
-    S[5] = C[35] * E[5];
+    double E[6], S[6];  // total strain, effective (undamaged) stress
+    fem::accumulate_strain_orthotropic_stress(C, de, t, h, s, e, E, S);
     const double L1 = len ? len[e] : L0, L2 = len ? len[s + e] : L0, L3 = len ? len[2 * s + e] : L0;
     // Failure indices and the length across each mode's crack.
     const double f[kModes] = {std::max(S[0], 0.0) / strength_[0],

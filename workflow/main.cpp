@@ -1,11 +1,12 @@
 // ncfsim: the command line (docs/cli.md). Subcommands run, check, render, report.
-// Exit codes: 0 success, 1 other error (incl. an interrupted run), 2 bad input, 3 numerical failure.
+// Exit codes: 0 success, 1 other error (incl. an interrupted run), 2 bad input, 3 numerical
+// failure.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-
-#include <CLI/CLI.hpp>
-#include <spdlog/spdlog.h>
 
 #include "fem/errors.hpp"
 #include "fem/petsc_vector.hpp"
@@ -36,35 +37,41 @@ void require_output_folder(const std::filesystem::path& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ncfsim: meso-mechanical drape-to-failure simulation of stitched carbon fabric "
-               "(explicit finite elements)"};
+  CLI::App app{
+      "ncfsim: meso-mechanical drape-to-failure simulation of stitched carbon fabric "
+      "(explicit finite elements)"};
   app.set_version_flag("--version", std::string("ncfsim ") + wf::kVersion);
   app.require_subcommand(1);
   bool quiet = false, verbose = false;
-  app.add_flag("-q,--quiet", quiet, "Only warnings and errors on the console (log.txt keeps everything)");
+  app.add_flag("-q,--quiet", quiet,
+               "Only warnings and errors on the console (log.txt keeps everything)");
   app.add_flag("-v,--verbose", verbose, "Debug messages on the console and in log.txt");
 
   std::string case_file, out_dir;
   std::vector<std::string> overrides;
   int ranks = 1;
   double progress = 5.0;
-  auto* run = app.add_subcommand("run", "Run a case: writes summary.json, history.csv, log.txt, "
-                                        "results.h5/.xdmf and figures to the output folder");
+  auto* run = app.add_subcommand("run",
+                                 "Run a case: writes summary.json, history.csv, log.txt, "
+                                 "results.h5/.xdmf and figures to the output folder");
   run->add_option("case", case_file, "Case file (TOML)")->required();
   run->add_option("-o,--output", out_dir, "Output folder (default results/<case name>)");
-  run->add_option("--set", overrides, "Override a case key: --set KEY=VALUE (repeatable), e.g. "
-                                      "--set mesh.resolution=coarse");
+  run->add_option("--set", overrides,
+                  "Override a case key: --set KEY=VALUE (repeatable), e.g. "
+                  "--set mesh.resolution=coarse");
   run->add_option("--np", ranks, "MPI ranks (default 1)")->check(CLI::Range(1, 1 << 20));
   run->add_option("--progress-interval", progress, "Seconds between progress lines (default 5)")
       ->check(CLI::PositiveNumber);
 
-  auto* check = app.add_subcommand("check", "Validate a case without running it (exit 0, or 2 with the "
-                                            "file, key and allowed range)");
+  auto* check = app.add_subcommand("check",
+                                   "Validate a case without running it (exit 0, or 2 with the "
+                                   "file, key and allowed range)");
   check->add_option("case", case_file, "Case file (TOML)")->required();
   check->add_option("--set", overrides, "Override a case key: --set KEY=VALUE (repeatable)");
 
   std::string folder;
-  auto* render = app.add_subcommand("render", "(Re)draw the figures of a finished run (off-screen)");
+  auto* render =
+      app.add_subcommand("render", "(Re)draw the figures of a finished run (off-screen)");
   render->add_option("outdir", folder, "Output folder of a run")->required();
   auto* report = app.add_subcommand("report", "Write report.html for a finished run");
   report->add_option("outdir", folder, "Output folder of a run")->required();
@@ -73,35 +80,61 @@ int main(int argc, char** argv) {
   std::string shear = "positive";
   auto* calibrate = app.add_subcommand("calibrate", "Calibrate model parameters from test data");
   auto* cal_stitch = calibrate->add_subcommand(
-      "stitch", "Stitch force-strain law from bias-extension force data (Eq. 2-6): positive shear "
-                "calibrates the 'I' stitches, negative shear the 'Lambda' stitches");
+      "stitch",
+      "Stitch force-strain law from bias-extension force data (Eq. 2-6): positive shear "
+      "calibrates the 'I' stitches, negative shear the 'Lambda' stitches");
   calibrate->require_subcommand(1);
-  cal_stitch->add_option("data", sc.data, "CSV with a header row")->required()->check(CLI::ExistingFile);
-  cal_stitch->add_option("--extension-column", sc.extension_column, "Extension column (default extension_m)");
+  cal_stitch->add_option("data", sc.data, "CSV with a header row")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cal_stitch->add_option("--extension-column", sc.extension_column,
+                         "Extension column (default extension_m)");
   cal_stitch->add_option("--force-column", sc.force_column, "Force column (default force_N)");
-  cal_stitch->add_option("--extension-scale", sc.extension_scale, "Factor to m (1e-3 for mm)")->check(CLI::PositiveNumber);
-  cal_stitch->add_option("--force-scale", sc.force_scale, "Factor to N")->check(CLI::PositiveNumber);
-  cal_stitch->add_option("--shear", shear, "positive | negative")->check(CLI::IsMember({"positive", "negative"}));
-  cal_stitch->add_option("--coupon-length", sc.coupon.length, "Free length H, m (default 0.25)")->check(CLI::PositiveNumber);
-  cal_stitch->add_option("--coupon-width", sc.coupon.width, "Width W, m (default 0.05)")->check(CLI::PositiveNumber);
-  cal_stitch->add_option("--stitch-length", sc.coupon.stitch_length, "Stitch length c0, m (default 2.5e-3)")->check(CLI::PositiveNumber);
-  cal_stitch->add_option("--gauge", sc.coupon.gauge, "Wale spacing h0, m (default 5.08e-3)")->check(CLI::PositiveNumber);
-  cal_stitch->add_option("--max-shear-deg", sc.max_shear_deg, "Use data up to this central shear (default 30)")->check(CLI::Range(1.0, 60.0));
-  cal_stitch->add_option("--points", sc.points, "Points of the law (default 12)")->check(CLI::Range(2, 200));
+  cal_stitch->add_option("--extension-scale", sc.extension_scale, "Factor to m (1e-3 for mm)")
+      ->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--force-scale", sc.force_scale, "Factor to N")
+      ->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--shear", shear, "positive | negative")
+      ->check(CLI::IsMember({"positive", "negative"}));
+  cal_stitch->add_option("--coupon-length", sc.coupon.length, "Free length H, m (default 0.25)")
+      ->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--coupon-width", sc.coupon.width, "Width W, m (default 0.05)")
+      ->check(CLI::PositiveNumber);
+  cal_stitch
+      ->add_option("--stitch-length", sc.coupon.stitch_length,
+                   "Stitch length c0, m (default 2.5e-3)")
+      ->check(CLI::PositiveNumber);
+  cal_stitch->add_option("--gauge", sc.coupon.gauge, "Wale spacing h0, m (default 5.08e-3)")
+      ->check(CLI::PositiveNumber);
+  cal_stitch
+      ->add_option("--max-shear-deg", sc.max_shear_deg,
+                   "Use data up to this central shear (default 30)")
+      ->check(CLI::Range(1.0, 60.0));
+  cal_stitch->add_option("--points", sc.points, "Points of the law (default 12)")
+      ->check(CLI::Range(2, 200));
   cal_stitch->add_option("--name", sc.law_name, "Name of the [[bar_law]] (default stitch)");
   cal_stitch->add_option("-o,--output", sc.out_dir, "Output folder (default stitch_calibration)");
 
   wf::TowBendingCalibration tb;
   auto* cal_bend = calibrate->add_subcommand(
-      "tow-bending", "Tow fibre modulus E11f that gives a target ASTM D1388 bending length in the "
-                     "virtual cantilever test (the case needs an [[output.bending_length]] probe)");
-  cal_bend->add_option("case", tb.case_file, "Cantilever-bending case (TOML)")->required()->check(CLI::ExistingFile);
-  cal_bend->add_option("--target-bending-length", tb.target_bending_length, "Measured bending length c, m")
-      ->required()->check(CLI::PositiveNumber);
-  cal_bend->add_option("--tolerance", tb.tolerance, "Relative tolerance on c (default 0.01)")->check(CLI::Range(1e-4, 0.2));
-  cal_bend->add_option("--max-runs", tb.max_runs, "Most simulation runs (default 6)")->check(CLI::Range(1, 50));
+      "tow-bending",
+      "Tow fibre modulus E11f that gives a target ASTM D1388 bending length in the "
+      "virtual cantilever test (the case needs an [[output.bending_length]] probe)");
+  cal_bend->add_option("case", tb.case_file, "Cantilever-bending case (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cal_bend
+      ->add_option("--target-bending-length", tb.target_bending_length,
+                   "Measured bending length c, m")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  cal_bend->add_option("--tolerance", tb.tolerance, "Relative tolerance on c (default 0.01)")
+      ->check(CLI::Range(1e-4, 0.2));
+  cal_bend->add_option("--max-runs", tb.max_runs, "Most simulation runs (default 6)")
+      ->check(CLI::Range(1, 50));
   cal_bend->add_option("--set", tb.overrides, "Override a case key (repeatable)");
-  cal_bend->add_option("-o,--output", tb.out_dir, "Output folder (default tow_bending_calibration)");
+  cal_bend->add_option("-o,--output", tb.out_dir,
+                       "Output folder (default tow_bending_calibration)");
 
   try {
     app.parse(argc, argv);
@@ -109,20 +142,16 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : wf::kBadInput;
   }
-  const wf::Verbosity verbosity = quiet ? wf::Verbosity::Quiet : verbose ? wf::Verbosity::Verbose : wf::Verbosity::Normal;
+  const wf::Verbosity verbosity = quiet     ? wf::Verbosity::Quiet
+                                  : verbose ? wf::Verbosity::Verbose
+                                            : wf::Verbosity::Normal;
 
   try {
-    if (*check) {
-      wf::find_stage(wf::case_kind(case_file, overrides), case_file);  // a kind this build runs
-      auto ec = wf::load_engine_case(case_file, overrides);
-      // Building the solver checks what only the assembled model can show (massless nodes, steps).
-      ncfsim::fem::PetscSession petsc;
-      if (const int code = wf::refuse_many_ranks()) return code;
-      ncfsim::fem::ExplicitSolver probe(ec.model);
-      std::printf("%s: OK (case '%s', %zu nodes, %zu hexahedra, %zu bars, stable step %.4g s, about %.3g cycles)\n",
-                  case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(), probe.n_elements(ncfsim::fem::ElementKind::Hex8), probe.n_elements(ncfsim::fem::ElementKind::Bar2),
-                  probe.time_step(), ec.model.time.end_time / probe.time_step());
-      return wf::kSuccess;
+    if (*check) {  // [case] kind -> its stage's check
+      wf::StageCall call;
+      call.case_file = case_file;
+      call.overrides = overrides;
+      return wf::check_stage(call);
     }
     if (*run) {  // [case] kind -> its stage (workflow/stages/stage_registry.hpp)
       wf::StageCall call;
@@ -136,19 +165,23 @@ int main(int argc, char** argv) {
       return wf::run_stage(call);
     }
     if (*cal_stitch) {
-      sc.sign = shear == "negative" ? ncfsim::drape::ShearSign::Negative : ncfsim::drape::ShearSign::Positive;
+      sc.sign = shear == "negative" ? ncfsim::drape::ShearSign::Negative
+                                    : ncfsim::drape::ShearSign::Positive;
       wf::calibrate_stitch(sc);
-      std::printf("%s: stitch_law.csv, stitch_law.toml, figures/stitch_law.png, figures/stitch_fit.png\n",
-                  sc.out_dir.c_str());
+      std::printf(
+          "%s: stitch_law.csv, stitch_law.toml, figures/stitch_law.png, figures/stitch_fit.png\n",
+          sc.out_dir.c_str());
       return wf::kSuccess;
     }
     if (*cal_bend) {
       ncfsim::fem::PetscSession petsc;
       if (const int code = wf::refuse_many_ranks()) return code;
       const auto r = wf::calibrate_tow_bending(tb);
-      std::printf("E11f = %.6g Pa gives a bending length of %.6g m (target %.6g m) after %d runs%s; see %s\n", r.E11f,
-                  r.bending_length, tb.target_bending_length, r.runs, r.converged ? "" : " (NOT converged)",
-                  (tb.out_dir / "calibration.json").c_str());
+      std::printf(
+          "E11f = %.6g Pa gives a bending length of %.6g m (target %.6g m) after %d runs%s; see "
+          "%s\n",
+          r.E11f, r.bending_length, tb.target_bending_length, r.runs,
+          r.converged ? "" : " (NOT converged)", (tb.out_dir / "calibration.json").c_str());
       return r.converged ? wf::kSuccess : wf::kNumericalFailure;
     }
     if (*render) {

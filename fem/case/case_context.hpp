@@ -2,7 +2,7 @@
 // What the module case readers share while one case file is read: the reading context (the
 // document, the model being built, the parts and their origin, the names of materials and bar
 // laws, named node sets a selector can pick) and the registry of types (material type -> the
-// reader of its keys). One context per load; nothing global. docs/architecture-cases.md.
+// reader of its keys). One context per load; nothing global. docs/architecture.md.
 #include <cstdint>
 #include <functional>
 #include <map>

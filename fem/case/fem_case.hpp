@@ -28,6 +28,9 @@ void read_loads(CaseReadContext& ctx);
 /// [[tool]] (rigid tools), [[contact]] (deformable contacts).
 void read_tools(CaseReadContext& ctx);
 void read_contacts(CaseReadContext& ctx);
+/// The geometry keys of a [[tool]] (shape, point, axis, radius, minor_radius, body_inside, file,
+/// scale, search_radius): also the surfaces of a kinematic drape.
+void read_rigid_surface(const TableReader& t, RigidSurface& s);
 /// [time] (needs the picture frames: their rate follows from end_time).
 void read_time(CaseReadContext& ctx);
 

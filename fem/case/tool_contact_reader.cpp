@@ -31,7 +31,9 @@ void read_tool_stl(const TableReader& t, RigidSurface& s) {
   s.search_radius = t.number("search_radius", Range::positive());
 }
 
-void read_tool_surface(const TableReader& t, RigidSurface& s) {
+}  // namespace
+
+void read_rigid_surface(const TableReader& t, RigidSurface& s) {
   const std::string shape = t.choice("shape", {"plane", "sphere", "cylinder", "torus", "plane_with_hole", "stl"}, "");
   s.point = to_v3(t.vec3_or("point", {0, 0, 0}));
   if (t.has("axis") || shape != "stl") s.axis = unit_axis(t, "axis", {0, 0, 1});
@@ -47,6 +49,8 @@ void read_tool_surface(const TableReader& t, RigidSurface& s) {
   if (shape == "sphere" || shape == "cylinder" || shape == "torus") s.body_inside = t.boolean("body_inside", false);
   if (shape == "stl") read_tool_stl(t, s);
 }
+
+namespace {
 
 void read_tool_motion(const TableReader& t, ToolMotion& m) {
   const std::string motion = t.choice("motion", {"fixed", "velocity", "force"}, "fixed");
@@ -65,7 +69,7 @@ void read_tool_motion(const TableReader& t, ToolMotion& m) {
 void read_tool(CaseReadContext& ctx, const TableReader& t) {
   RigidTool tool;
   tool.name = t.string("name");
-  read_tool_surface(t, tool.surface);
+  read_rigid_surface(t, tool.surface);
   read_tool_motion(t, tool.motion);
   tool.friction = t.number("friction", 0.0, Range::non_negative());
   tool.penalty_scale = t.number("penalty_scale", 0.1, Range::open_closed(0, 1.0));

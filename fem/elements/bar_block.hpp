@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "fem/elements/block_of.hpp"
 #include "fem/elements/element_step.hpp"
 
 namespace ncfsim::fem {
@@ -60,12 +61,7 @@ void bar_lumped_mass(const BarBlock& b, double* mass);
 void bar_internal_forces(BarBlock& b, const double* x, double* f, ElementEnergyIncrement& energy,
                          StableStep& step);
 
-// The block behind an element group (fem/elements/element_group.hpp), null for another kind.
-class ElementGroup;
-template <class Block>
-Block* block_of(ElementGroup& g);
-template <class Block>
-const Block* block_of(const ElementGroup& g);
+// The block behind an element group (fem/elements/block_of.hpp), null for another kind.
 template <>
 BarBlock* block_of<BarBlock>(ElementGroup& g);
 template <>

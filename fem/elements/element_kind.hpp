@@ -2,7 +2,7 @@
 // The element kinds the engine knows, with what the rest of the code may ask of a kind without
 // naming it: nodes per element, names for messages and output, and the faces that bound a solid
 // element (contact surfaces are made of them). A new kind adds an enumerator here, a row in each
-// table below and a group in fem/elements/ (docs/architecture-elements.md).
+// table below and a group in fem/elements/ (docs/architecture.md).
 #include <array>
 #include <cstdint>
 #include <span>
@@ -22,6 +22,11 @@ constexpr int nodes_per_element(ElementKind k) {
 /// Noun for messages ("hexahedron 12 at ...").
 constexpr const char* element_noun(ElementKind k) {
   constexpr const char* n[] = {"hexahedron", "bar"};
+  return n[static_cast<int>(k)];
+}
+/// Plural noun for counts in messages ("1200 hexahedra").
+constexpr const char* element_plural(ElementKind k) {
+  constexpr const char* n[] = {"hexahedra", "bars"};
   return n[static_cast<int>(k)];
 }
 /// Short name for output and summaries ("hex8").

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "fem/elements/block_of.hpp"
 #include "fem/elements/element_step.hpp"
 #include "fem/material.hpp"
 
@@ -99,12 +100,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
                           ElementEnergyIncrement& energy, StableStep& step,
                           const double* x_ref = nullptr);
 
-// The block behind an element group (fem/elements/element_group.hpp), null for another kind.
-class ElementGroup;
-template <class Block>
-Block* block_of(ElementGroup& g);
-template <class Block>
-const Block* block_of(const ElementGroup& g);
+// The block behind an element group (fem/elements/block_of.hpp), null for another kind.
 template <>
 Hex8Block* block_of<Hex8Block>(ElementGroup& g);
 template <>

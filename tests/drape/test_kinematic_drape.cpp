@@ -33,6 +33,17 @@ DrapeSurface hemisphere_on_plane() {
   return s;
 }
 
+// A solid cylinder of radius r about `axis` through the origin.
+DrapeSurface cylinder(V3 axis, double r) {
+  DrapeSurface s;
+  fem::RigidSurface cyl;
+  cyl.shape = fem::ToolShape::Cylinder;
+  cyl.axis = axis;
+  cyl.radius = r;
+  s.bodies.push_back(cyl);
+  return s;
+}
+
 KinematicDrapeSpec pm45(double spacing, double reach) {
   KinematicDrapeSpec k;
   k.pole = {0, 0, kR + 0.01};
@@ -84,12 +95,7 @@ TEST(KinematicDrape, NoShearAlongTheGeneratorsOfASphere) {
 }
 
 TEST(KinematicDrape, CylinderWithAxialAndHoopFibresDoesNotShear) {
-  DrapeSurface surf;
-  fem::RigidSurface cyl;
-  cyl.shape = fem::ToolShape::Cylinder;
-  cyl.axis = {1, 0, 0};
-  cyl.radius = 0.05;
-  surf.bodies.push_back(cyl);
+  const DrapeSurface surf = cylinder({1, 0, 0}, 0.05);
   KinematicDrapeSpec k;
   k.pole = {0, 0, 0.06};
   k.fibre1 = {1, 0, 0};  // along the axis
@@ -152,12 +158,7 @@ TEST(KinematicDrape, ShearDependsOnTheAngularPositionNotTheRadius) {
 TEST(RingMeasure, InterpolatesAFieldAroundACylinderAndTakesQuadrantMaxima) {
   // A vertical cylinder of radius 50 mm as a net of axial and hoop fibres; node value
   // 20 + 10 x / R: the ring reads 20 + 10 cos(azimuth) (to the chord error of the net).
-  DrapeSurface surf;
-  fem::RigidSurface cyl;
-  cyl.shape = fem::ToolShape::Cylinder;
-  cyl.axis = {0, 0, 1};
-  cyl.radius = 0.05;
-  surf.bodies.push_back(cyl);
+  const DrapeSurface surf = cylinder({0, 0, 1}, 0.05);
   KinematicDrapeSpec k;
   k.pole = {0.06, 0, 0.03};
   k.fibre1 = {0, 0, 1};

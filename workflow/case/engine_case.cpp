@@ -1,5 +1,5 @@
 // The case orchestration: [case], the module readers in order (fem/case, drape/case), [output]
-// and [figures]. Every module reads and range-checks its own sections; docs/architecture-cases.md.
+// and [figures]. Every module reads and range-checks its own sections; docs/architecture.md.
 #include "workflow/case/engine_case.hpp"
 
 #include "drape/case/drape_case.hpp"

@@ -2,7 +2,7 @@
 // A case for the explicit engine, read from TOML: mesh (structured blocks and bar lines), materials,
 // bar laws, parts, constraints, loads, rigid tools, time controls, output, figures.
 // The keys are documented in docs/case-file.md; every value is range-checked before any run, once,
-// by the module that owns its section (fem/case, drape/case; docs/architecture-cases.md).
+// by the module that owns its section (fem/case, drape/case; docs/architecture.md).
 #include <filesystem>
 #include <string>
 #include <vector>

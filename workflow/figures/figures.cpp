@@ -18,12 +18,22 @@ using json = nlohmann::json;
 json plot_json(const PlotSpec& p) {
   json imports = json::array(), refs = json::array();
   for (const auto& i : p.imports)
-    imports.push_back({{"label", i.label}, {"file", i.file.string()}, {"x", i.x}, {"y", i.y},
-                       {"x_scale", i.x_scale}, {"y_scale", i.y_scale}});
+    imports.push_back({{"label", i.label},
+                       {"file", i.file.string()},
+                       {"x", i.x},
+                       {"y", i.y},
+                       {"x_scale", i.x_scale},
+                       {"y_scale", i.y_scale}});
   for (const auto& r : p.references) refs.push_back({{"label", r.label}, {"y", r.y}});
-  return {{"name", p.name},       {"title", p.title},     {"x", p.x},
-          {"y", p.y},             {"x_scale", p.x_scale}, {"y_scale", p.y_scale},
-          {"x_label", p.x_label}, {"y_label", p.y_label}, {"imports", imports},
+  return {{"name", p.name},
+          {"title", p.title},
+          {"x", p.x},
+          {"y", p.y},
+          {"x_scale", p.x_scale},
+          {"y_scale", p.y_scale},
+          {"x_label", p.x_label},
+          {"y_label", p.y_label},
+          {"imports", imports},
           {"references", refs}};
 }
 
@@ -57,38 +67,77 @@ void write_figure_specs(const std::filesystem::path& dir, const EngineCase& ec) 
       if (q.name == p.name) return;
     plots.push_back(plot_json(p));
   };
-  add_default(PlotSpec{"energy_balance", ec.name + ": energy balance", "time",
-                             {"kinetic_energy_J", "internal_energy_J", "hourglass_energy_J", "contact_energy_J",
-                              "damping_energy_J", "external_work_J", "total_energy_J"},
-                             1.0, 1.0, "time [s]", "energy [J]", {}, {}});
+  add_default(
+      PlotSpec{"energy_balance",
+               ec.name + ": energy balance",
+               "time",
+               {"kinetic_energy_J", "internal_energy_J", "hourglass_energy_J", "contact_energy_J",
+                "damping_energy_J", "external_work_J", "total_energy_J"},
+               1.0,
+               1.0,
+               "time [s]",
+               "energy [J]",
+               {},
+               {}});
   for (const auto& t : ec.model.tools)
-    add_default(PlotSpec{t.name + "_force_displacement", ec.name + ": " + t.name + " force",
-                               t.name + "_displacement_m", {t.name + "_force_N"}, 1e3, 1.0,
-                               t.name + " displacement [mm]", t.name + " force [N]", {}, {}});
+    add_default(PlotSpec{t.name + "_force_displacement",
+                         ec.name + ": " + t.name + " force",
+                         t.name + "_displacement_m",
+                         {t.name + "_force_N"},
+                         1e3,
+                         1.0,
+                         t.name + " displacement [mm]",
+                         t.name + " force [N]",
+                         {},
+                         {}});
   for (const auto& p : ec.probes)
-    add_default(PlotSpec{p.name + "_displacement", ec.name + ": " + p.name + " displacement", "time",
-                               {p.name + "_displacement_x_m", p.name + "_displacement_y_m", p.name + "_displacement_z_m"},
-                               1.0, 1e3, "time [s]", "displacement [mm]", {}, {}});
+    add_default(PlotSpec{
+        p.name + "_displacement",
+        ec.name + ": " + p.name + " displacement",
+        "time",
+        {p.name + "_displacement_x_m", p.name + "_displacement_y_m", p.name + "_displacement_z_m"},
+        1.0,
+        1e3,
+        "time [s]",
+        "displacement [mm]",
+        {},
+        {}});
   for (const auto& p : ec.pictures)
-    pictures.push_back({{"name", p.name}, {"field", p.field}, {"component", p.component}, {"camera", p.camera},
-                        {"title", p.title}, {"follow_part", p.follow_part},
+    pictures.push_back({{"name", p.name},
+                        {"field", p.field},
+                        {"component", p.component},
+                        {"camera", p.camera},
+                        {"title", p.title},
+                        {"follow_part", p.follow_part},
                         {"deformation_scale", p.deformation_scale}});
   if (ec.pictures.empty()) {
-    if (ec.model.mesh.n_elements(fem::ElementKind::Hex8) > 0)
-      pictures.push_back({{"name", "final_von_mises"}, {"field", "von_mises_stress"}, {"camera", "iso"},
+    bool solids = false;  // elements that bound a volume have a stress tensor to picture
+    for (const auto& set : ec.model.mesh.sets)
+      solids = solids || (!set.empty() && !fem::element_faces(set.kind).empty());
+    if (solids)
+      pictures.push_back({{"name", "final_von_mises"},
+                          {"field", "von_mises_stress"},
+                          {"camera", "iso"},
                           {"title", ec.name + ": von Mises stress, final state"}});
-    pictures.push_back({{"name", "final_displacement"}, {"field", "displacement_magnitude"}, {"camera", "iso"},
+    pictures.push_back({{"name", "final_displacement"},
+                        {"field", "displacement_magnitude"},
+                        {"camera", "iso"},
                         {"title", ec.name + ": displacement, final state"}});
   }
-  write_file_atomically(dir / "figures.json", json{{"plots", plots}, {"pictures", pictures}}.dump(2) + "\n");
+  write_file_atomically(dir / "figures.json",
+                        json{{"plots", plots}, {"pictures", pictures}}.dump(2) + "\n");
 }
 
-std::vector<std::filesystem::path> render_figures(const std::filesystem::path& dir, spdlog::logger& log) {
+std::vector<std::filesystem::path> render_figures(const std::filesystem::path& dir,
+                                                  spdlog::logger& log) {
   std::ifstream in(dir / "figures.json");
-  if (!in) throw std::runtime_error((dir / "figures.json").string() + " not found (is this a run's output folder?)");
+  if (!in)
+    throw std::runtime_error((dir / "figures.json").string() +
+                             " not found (is this a run's output folder?)");
   const json spec = json::parse(in);
   std::string why;
-  if (!render::offscreen_rendering_available(&why)) throw std::runtime_error("no off-screen rendering: " + why);
+  if (!render::offscreen_rendering_available(&why))
+    throw std::runtime_error("no off-screen rendering: " + why);
   std::vector<std::filesystem::path> out;
   std::filesystem::create_directories(dir / "figures");
 
@@ -147,7 +196,8 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
         if (f.name == "displacement") {
           render::MeshField mag{"displacement_magnitude", "m", false, 1, {}};
           for (std::size_t i = 0; i + 2 < f.values.size(); i += 3)
-            mag.values.push_back(std::sqrt(f.values[i] * f.values[i] + f.values[i + 1] * f.values[i + 1] +
+            mag.values.push_back(std::sqrt(f.values[i] * f.values[i] +
+                                           f.values[i + 1] * f.values[i + 1] +
                                            f.values[i + 2] * f.values[i + 2]));
           rm.fields.push_back(std::move(mag));
         }
@@ -181,7 +231,8 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
             std::array<double, 6> b{1e300, -1e300, 1e300, -1e300, 1e300, -1e300};
             auto grow = [&](std::int64_t node) {
               for (int c = 0; c < 3; ++c) {
-                const double v = rm.points[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)];
+                const double v =
+                    rm.points[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)];
                 b[2 * c] = std::min(b[2 * c], v), b[2 * c + 1] = std::max(b[2 * c + 1], v);
               }
             };

@@ -11,6 +11,14 @@ namespace ncfsim::workflow {
 
 using json = nlohmann::json;
 
+std::string element_counts(const fem::ExplicitSolver& s) {
+  std::string out;
+  for (const auto k : fem::kElementKinds)
+    out +=
+        (out.empty() ? "" : ", ") + std::to_string(s.n_elements(k)) + " " + fem::element_plural(k);
+  return out;
+}
+
 json summary_header(const EngineCase& ec, const RunOptions& options) {
   json summary;
   summary["case"] = ec.name;
@@ -25,20 +33,24 @@ json summary_header(const EngineCase& ec, const RunOptions& options) {
 
 void describe_model(const fem::ExplicitSolver& solver, spdlog::logger& log, json& summary) {
   const fem::Model& model = solver.model();
-  log.info("mesh: {} nodes, {} hexahedra, {} bars, {} parts, {} tools", model.mesh.n_nodes(), solver.n_elements(fem::ElementKind::Hex8),
-           solver.n_elements(fem::ElementKind::Bar2), model.mesh.part_names.size(), model.tools.size());
+  log.info("mesh: {} nodes, {}, {} parts, {} tools", model.mesh.n_nodes(), element_counts(solver),
+           model.mesh.part_names.size(), model.tools.size());
   const auto& st = solver.controlling_element();
   log.info("stable step {:.4g} s (safety factor {}), controlled by {} {}", solver.time_step(),
            model.time.safety_factor, fem::element_noun(st.kind), st.element);
   json parts = json::object();
   for (const auto& pm : solver.part_masses()) {
     const double pct = pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0;
-    log.info("  part {:<16} mass {:.5g} kg, added by mass scaling {:.5g} kg ({:.3g} %)", pm.part, pm.mass,
-             pm.added_mass, pct);
-    parts[pm.part] = {{"mass_kg", pm.mass}, {"added_mass_kg", pm.added_mass}, {"added_mass_percent", pct}};
+    log.info("  part {:<16} mass {:.5g} kg, added by mass scaling {:.5g} kg ({:.3g} %)", pm.part,
+             pm.mass, pm.added_mass, pct);
+    parts[pm.part] = {
+        {"mass_kg", pm.mass}, {"added_mass_kg", pm.added_mass}, {"added_mass_percent", pct}};
   }
-  log.info("end time {:.4g} s: about {:.3g} cycles", model.time.end_time, model.time.end_time / solver.time_step());
-  summary["elements"] = {{"hex8", solver.n_elements(fem::ElementKind::Hex8)}, {"bar2", solver.n_elements(fem::ElementKind::Bar2)}};
+  log.info("end time {:.4g} s: about {:.3g} cycles", model.time.end_time,
+           model.time.end_time / solver.time_step());
+  summary["elements"] = nlohmann::json::object();
+  for (const auto k : fem::kElementKinds)
+    summary["elements"][fem::element_kind_name(k)] = solver.n_elements(k);
   summary["nodes"] = model.mesh.n_nodes();
   summary["parts"] = parts;
   summary["end_time_s"] = model.time.end_time;
@@ -61,12 +73,15 @@ void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json
   summary["friction_energy_J"] = en.friction;
   summary["damping_energy_J"] = en.damping;
   summary["external_work_J"] = en.external_work;
-  summary["hourglass_to_internal_ratio"] = en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
+  summary["hourglass_to_internal_ratio"] =
+      en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
   summary["eroded_elements"] = solver.erosions().size();
   summary["eroded_internal_energy_J"] = en.eroded_internal;
   const auto& tm = solver.timers();
-  summary["timers_s"] = {{"internal_force", tm.internal_force}, {"contact", tm.contact},
-                         {"update", tm.update}, {"output", tm.output}};
+  summary["timers_s"] = {{"internal_force", tm.internal_force},
+                         {"contact", tm.contact},
+                         {"update", tm.update},
+                         {"output", tm.output}};
 }
 
 namespace {
@@ -74,7 +89,9 @@ namespace {
 // Mean of a column over a time window (or the ratio of two columns' increments over it).
 void add_mean(const SummaryMean& sm, const RunHistory& h, json& summary) {
   const int c = h.index(sm.column), cp = h.index(sm.per_column);
-  const auto col = [](const std::vector<double>& r, int k) { return r[static_cast<std::size_t>(k)]; };
+  const auto col = [](const std::vector<double>& r, int k) {
+    return r[static_cast<std::size_t>(k)];
+  };
   double sum = 0;
   std::size_t n = 0;
   const std::vector<double>*first = nullptr, *last = nullptr;
@@ -106,10 +123,12 @@ void add_samples(const SummarySamples& ss, const RunHistory& h, json& summary) {
       const int cy = h.index(column);
       double val = std::numeric_limits<double>::quiet_NaN();
       for (std::size_t r = 1; cx >= 0 && cy >= 0 && r < rows.size(); ++r) {
-        const double x0 = rows[r - 1][static_cast<std::size_t>(cx)], x1 = rows[r][static_cast<std::size_t>(cx)];
+        const double x0 = rows[r - 1][static_cast<std::size_t>(cx)],
+                     x1 = rows[r][static_cast<std::size_t>(cx)];
         if ((x0 - xv) * (x1 - xv) <= 0 && x1 != x0) {
           const double w = (xv - x0) / (x1 - x0);
-          val = (1 - w) * rows[r - 1][static_cast<std::size_t>(cy)] + w * rows[r][static_cast<std::size_t>(cy)];
+          val = (1 - w) * rows[r - 1][static_cast<std::size_t>(cy)] +
+                w * rows[r][static_cast<std::size_t>(cy)];
           break;
         }
       }

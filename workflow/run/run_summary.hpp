@@ -2,8 +2,9 @@
 // summary.json of a run (docs/output.md): the header, the model, the state at a frame and at the
 // end (energies, erosion, timers), and the summary samples and means over the history rows. The
 // measures add their own entries (fem/run_measure.hpp).
-#include <nlohmann/json.hpp>
 #include <spdlog/logger.h>
+
+#include <nlohmann/json.hpp>
 
 #include "fem/solver.hpp"
 #include "workflow/case/engine_case.hpp"
@@ -20,8 +21,12 @@ nlohmann::json summary_header(const EngineCase& ec, const RunOptions& options);
 /// end_time_s, time_step_initial_s, energy_balance_limit.
 void describe_model(const fem::ExplicitSolver& s, spdlog::logger& log, nlohmann::json& summary);
 
+/// "N hexahedra, M bars" over every element kind (for the log and `ncfsim check`).
+std::string element_counts(const fem::ExplicitSolver& s);
+
 /// cycles, time reached, steps, the energy balance and its terms, hourglass ratio, erosion, timers.
-void add_state_summary(const fem::ExplicitSolver& s, double energy_balance_error_max, nlohmann::json& summary);
+void add_state_summary(const fem::ExplicitSolver& s, double energy_balance_error_max,
+                       nlohmann::json& summary);
 
 /// The case's [[output.mean]] and [[output.sample]] values over the kept history rows (null where
 /// they cannot be measured).

@@ -2,9 +2,13 @@
 
 #include <cstdio>
 
+#include "drape/case/kinematic_case.hpp"
+#include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
 #include "fem/petsc_vector.hpp"
-#include "fem/case/toml_reader.hpp"
+#include "fem/solver.hpp"
+#include "workflow/run/run_summary.hpp"
+#include "workflow/stages/kinematic_drape_stage.hpp"
 
 namespace ncfsim::workflow {
 
@@ -15,6 +19,28 @@ int run_engine_stage(const StageCall& call) {
   fem::PetscSession petsc;  // after the case: bad input is reported without starting MPI
   if (const int code = refuse_many_ranks()) return code;
   return run_engine_case(ec, call.options);
+}
+
+int check_engine_stage(const StageCall& call) {
+  auto ec = load_engine_case(call.case_file, call.overrides);
+  // Building the solver checks what only the assembled model can show (massless nodes, steps).
+  fem::PetscSession petsc;
+  if (const int code = refuse_many_ranks()) return code;
+  fem::ExplicitSolver probe(ec.model);
+  std::printf("%s: OK (case '%s', %zu nodes, %s, stable step %.4g s, about %.3g cycles)\n",
+              call.case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(),
+              element_counts(probe).c_str(), probe.time_step(),
+              ec.model.time.end_time / probe.time_step());
+  return kSuccess;
+}
+
+int check_kinematic_drape_stage(const StageCall& call) {
+  const auto kc = drape::load_kinematic_drape_case(call.case_file, call.overrides);
+  std::printf(
+      "%s: OK (case '%s', kinematic drape, %zu surfaces, net of %d x %d joints at %.4g m)\n",
+      call.case_file.c_str(), kc.name.c_str(), kc.surface.bodies.size(), 2 * kc.net.half_nodes + 1,
+      2 * kc.net.half_nodes + 1, kc.net.spacing);
+  return kSuccess;
 }
 
 }  // namespace
@@ -33,13 +59,17 @@ int refuse_many_ranks() {
 
 const std::vector<Stage>& stages() {
   static const std::vector<Stage> registry{
-      {"engine", "explicit finite-element run (virtual tests, forming, crush)", &run_engine_stage},
+      {"engine", "explicit finite-element run (virtual tests, forming, crush)", &run_engine_stage,
+       &check_engine_stage},
+      {"kinematic_drape",
+       "pin-jointed net (fishnet) drape on rigid tool surfaces, ring shear measure",
+       &run_kinematic_drape_stage, &check_kinematic_drape_stage},
   };
   return registry;
 }
 
 const std::vector<std::string>& planned_stage_kinds() {
-  static const std::vector<std::string> planned{"kinematic_drape", "transfer", "crush", "workflow"};
+  static const std::vector<std::string> planned{"transfer", "crush", "workflow"};
   return planned;
 }
 
@@ -51,21 +81,28 @@ const Stage& find_stage(const std::string& kind, const std::filesystem::path& fi
   std::string planned;
   for (const auto& p : planned_stage_kinds()) planned += (planned.empty() ? "" : ", ") + p;
   throw InputError(file.string(), "case.kind",
-                   "'" + kind + "' is not a stage kind; allowed: " + allowed + " (planned, not in this build: " +
-                       planned + ")");
+                   "'" + kind + "' is not a stage kind; allowed: " + allowed +
+                       " (planned, not in this build: " + planned + ")");
 }
 
-std::string case_kind(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+std::string case_kind(const std::filesystem::path& file,
+                      const std::vector<std::string>& overrides) {
   const fem::CaseDocument doc = fem::CaseDocument::load(file, overrides);
   const auto* c = doc.root()["case"].as_table();
   if (!c || !c->contains("kind")) return "engine";
   const auto kind = (*c)["kind"].value<std::string>();
-  if (!kind) throw InputError(file.string(), "case.kind", "must be a string (allowed: a stage kind, e.g. engine)");
+  if (!kind)
+    throw InputError(file.string(), "case.kind",
+                     "must be a string (allowed: a stage kind, e.g. engine)");
   return *kind;
 }
 
 int run_stage(const StageCall& call) {
   return find_stage(case_kind(call.case_file, call.overrides), call.case_file).run(call);
+}
+
+int check_stage(const StageCall& call) {
+  return find_stage(case_kind(call.case_file, call.overrides), call.case_file).check(call);
 }
 
 }  // namespace ncfsim::workflow

@@ -1,7 +1,7 @@
 #pragma once
 // `[case] kind` -> the stage that runs it. Today one stage, "engine" (any explicit model:
 // virtual tests, forming, crush); kinematic_drape, transfer, crush and workflow register here as
-// their issues land (docs/architecture-stages.md). A stage reads its own case file (its module's
+// their issues land (docs/architecture.md). A stage reads its own case file (its module's
 // reader), runs into the output folder and returns the exit code of the command line; it hands the
 // next stage its results.h5 (fem/io/stage_handoff.hpp).
 #include <filesystem>
@@ -24,6 +24,9 @@ struct Stage {
   std::string description;  // one line, for messages and --help
   /// Reads the case, runs it; returns the exit code (ExitCode). Bad input throws InputError.
   int (*run)(const StageCall& call) = nullptr;
+  /// `ncfsim check`: reads and checks the case (and what only the built model shows), prints one
+  /// line, returns the exit code. Bad input throws InputError.
+  int (*check)(const StageCall& call) = nullptr;
 };
 
 /// The registered stages, in the order they are listed in messages.
@@ -40,6 +43,8 @@ std::string case_kind(const std::filesystem::path& file, const std::vector<std::
 
 /// Looks the case's kind up and runs its stage.
 int run_stage(const StageCall& call);
+/// Looks the case's kind up and checks it (`ncfsim check`).
+int check_stage(const StageCall& call);
 
 /// Until the domain decomposition lands the engine runs on one MPI rank: started by mpirun on
 /// more, every rank would run the whole model and write the same files. Returns the exit code

@@ -1,0 +1,100 @@
+#include "drape/case/kinematic_case.hpp"
+
+#include <cmath>
+
+#include "fem/case/fem_case.hpp"
+#include "fem/case/toml_reader.hpp"
+#include "fem/errors.hpp"
+
+namespace ncfsim::drape {
+
+namespace {
+
+using fem::TableReader;
+using fem::V3;
+
+constexpr double kPi = 3.14159265358979323846;
+
+V3 unit(const TableReader& t, std::string_view key, std::array<double, 3> fallback) {
+  const auto a = t.vec3_or(key, fallback);
+  const V3 v{a[0], a[1], a[2]};
+  if (!(norm(v) > 0)) t.fail(key, "must be a non-zero vector");
+  return normalized(v);
+}
+
+void read_ring(const TableReader& r, RingSpec& ring) {
+  const auto c = r.vec3_or("centre", {0, 0, 0});
+  ring.centre = {c[0], c[1], c[2]};
+  ring.axis = unit(r, "axis", {0, 0, 1});
+  ring.zero_direction = unit(r, "zero_direction", {1, 0, 0});
+  if (norm(cross(ring.axis, ring.zero_direction)) < 1e-6)
+    r.fail("zero_direction", "must not be parallel to the ring axis");
+  ring.height = r.number("height", 0.04, Range::closed(-10, 10));
+  ring.step_deg = r.number("step_deg", 1.0, Range::open_closed(0.0, 90.0));
+}
+
+void read_net(const TableReader& n, KinematicDrapeCase& kc) {
+  const auto pole = n.vec3("pole");
+  kc.net.pole = {pole[0], pole[1], pole[2]};
+  kc.net.spacing = n.number("spacing", 2e-3, Range::open_closed(0.0, 0.1));
+  const double reach = n.number("reach", Range::positive());
+  const double half = std::ceil(reach / kc.net.spacing);
+  if (half > 5000)
+    n.fail("reach", "reach / spacing = " + std::to_string(half) +
+                        " joints per generator side, allowed <= 5000 (a net of 10^8 joints)");
+  kc.net.half_nodes = static_cast<int>(half);
+  const auto angles = n.numbers("fibre_angles_deg", Range::closed(-180, 180), 2);
+  if (angles.size() != 2)
+    n.fail("fibre_angles_deg", "give two fibre angles (deg), e.g. [45.0, -45.0]");
+  if (std::abs(std::sin((angles[0] - angles[1]) * kPi / 180)) < 0.05)
+    n.fail("fibre_angles_deg", "the two fibre directions must not be (nearly) parallel");
+  kc.fibre_angles_deg = {angles[0], angles[1]};
+  // In the plane normal to the ring axis, from the zero direction (the wale).
+  const V3 e1 =
+      normalized(kc.ring.zero_direction - dot(kc.ring.zero_direction, kc.ring.axis) * kc.ring.axis);
+  const V3 e2 = cross(kc.ring.axis, e1);
+  auto dir = [&](double deg) {
+    return std::cos(deg * kPi / 180) * e1 + std::sin(deg * kPi / 180) * e2;
+  };
+  kc.net.fibre1 = dir(angles[0]);
+  kc.net.fibre2 = dir(angles[1]);
+}
+
+}  // namespace
+
+KinematicDrapeCase load_kinematic_drape_case(const std::filesystem::path& file,
+                                             const std::vector<std::string>& overrides) {
+  fem::CaseDocument doc = fem::CaseDocument::load(file, overrides);
+  const TableReader root(doc, doc.root(), "");
+  KinematicDrapeCase kc;
+  kc.file = file;
+  kc.overrides = overrides;
+  const TableReader c = root.required_table("case");
+  kc.name = c.string("name");
+  if (kc.name.empty() || kc.name.find_first_of("/\\ ") != std::string::npos)
+    c.fail("name",
+           "must be a non-empty name without spaces or slashes (it names the output folder)");
+  c.choice("kind", {"kinematic_drape"}, "");
+  kc.description = c.string("description", "");
+  const auto surfaces = root.tables("surface");
+  if (surfaces.empty())
+    root.fail("surface", "missing: give at least one [[surface]] (the tool at its final position)");
+  for (const auto& s : surfaces) {
+    fem::RigidSurface rs;
+    fem::read_rigid_surface(s, rs);
+    kc.surface.bodies.push_back(rs);
+  }
+  if (auto r = root.table("ring")) read_ring(*r, kc.ring);
+  read_net(root.required_table("net"), kc);
+  double gap = 0;
+  V3 nrm;
+  if (!kc.surface.gap_at(kc.net.pole, gap, nrm))
+    root.fail("net.pole", "no [[surface]] answers at the pole");
+  if (gap < 0)
+    root.fail("net.pole", "lies inside a [[surface]] body (gap " + std::to_string(gap) +
+                              " m): start the net outside the tool");
+  doc.check_unknown_keys();
+  return kc;
+}
+
+}  // namespace ncfsim::drape
