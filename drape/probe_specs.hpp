@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "drape/ring_measure.hpp"
+
 namespace ncfsim::drape {
 
 /// In-plane shear angle between the fibres of two plies over the elements whose reference centroid
@@ -25,6 +27,14 @@ struct BendingLengthProbe {
   std::string name;
   int part = -1;
   std::vector<std::int32_t> root, tip;
+};
+
+/// The paper's Fig. 18 measure on a formed fabric: the inter-ply shear angle around the ring at
+/// a height above the blankholder plane (drape/ring_measure.hpp), from the elements of two plies.
+/// summary.json max_shear_deg_q1..q4, ring_shear.csv.
+struct RingShearProbe {
+  int part_a = -1, part_b = -1;
+  RingSpec ring;
 };
 
 /// What a [[mesh.fabric]] generated (echoed in the log and summary.json).

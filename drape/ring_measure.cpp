@@ -36,13 +36,24 @@ std::vector<RingSample> ring_shear(const std::vector<V3>& nodes,
   const V3 origin = ring.centre + ring.height * ring.axis;
   const int n = static_cast<int>(std::lround(360.0 / ring.step_deg));
   std::vector<RingSample> out(static_cast<std::size_t>(n));
+  // Only triangles that reach the ring's height can meet its rays (a formed part: a few %).
+  std::vector<std::array<std::int32_t, 3>> band;
+  for (const auto& t : triangles) {
+    double lo = 1e300, hi = -1e300;
+    for (auto v : t) {
+      const double h = dot(nodes[static_cast<std::size_t>(v)] - ring.centre, ring.axis);
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+    }
+    if (lo <= ring.height + 1e-12 && hi >= ring.height - 1e-12) band.push_back(t);
+  }
   for (int k = 0; k < n; ++k) {
     RingSample& smp = out[static_cast<std::size_t>(k)];
     smp.azimuth_deg = k * ring.step_deg;
     const double phi = smp.azimuth_deg * kPi / 180.0;
     const V3 d = std::cos(phi) * e1 + std::sin(phi) * e2;
     double best = std::numeric_limits<double>::max();
-    for (const auto& t : triangles) {
+    for (const auto& t : band) {
       // Moller-Trumbore ray-triangle intersection (ray origin + s d, s > 0).
       const V3 p0 = nodes[static_cast<std::size_t>(t[0])],
                p1 = nodes[static_cast<std::size_t>(t[1])],

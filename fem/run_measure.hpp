@@ -8,6 +8,7 @@
 // libraries that implement a measure link nlohmann_json.
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,12 @@ class RunMeasure {
   /// Writes its summary.json entries at the solver's current state (called at every frame and
   /// once at the end). A value that could not be measured is null.
   virtual void add_summary(const ExplicitSolver& s, nlohmann::json& summary) const { (void)s, (void)summary; }
+  /// Once at the end of the run: files of its own in the output folder (written atomically),
+  /// e.g. a drape's ring_shear.csv. Returns the file names it wrote.
+  virtual std::vector<std::string> write_files(const ExplicitSolver& s, const std::filesystem::path& dir) const {
+    (void)s, (void)dir;
+    return {};
+  }
 };
 
 /// Mean displacement of a set of nodes at the solver's current state (m).

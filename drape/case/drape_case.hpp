@@ -41,6 +41,8 @@ std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx, const 
 
 /// [[output.shear_probe]] and [[output.bending_length]] of the [output] table `o`.
 std::vector<ShearProbe> read_shear_probes(const fem::CaseReadContext& ctx, const fem::TableReader& o);
+/// [[output.ring_shear]] (at most one).
+std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& ctx, const fem::TableReader& o);
 std::vector<BendingLengthProbe> read_bending_probes(const fem::CaseReadContext& ctx, const fem::TableReader& o);
 
 /// The bias-extension coupon of an [[output.sample]] with analytic = "bias_extension" (else none).

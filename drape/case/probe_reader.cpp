@@ -16,7 +16,8 @@ std::vector<ShearProbe> read_shear_probes(const fem::CaseReadContext& ctx, const
     if (parts.size() != 2) t.fail("parts", "must name exactly 2 parts (the two plies)");
     sp.part_a = mesh.find_part(parts[0]);
     sp.part_b = mesh.find_part(parts[1]);
-    if (sp.part_a < 0 || sp.part_b < 0) t.fail("parts", "no part named '" + parts[sp.part_a < 0 ? 0 : 1] + "'");
+    if (sp.part_a < 0 || sp.part_b < 0)
+      t.fail("parts", "no part named '" + parts[sp.part_a < 0 ? 0 : 1] + "'");
     sp.box_min = t.vec3("box_min");
     sp.box_max = t.vec3("box_max");
     out.push_back(sp);
@@ -24,7 +25,41 @@ std::vector<ShearProbe> read_shear_probes(const fem::CaseReadContext& ctx, const
   return out;
 }
 
-std::vector<BendingLengthProbe> read_bending_probes(const fem::CaseReadContext& ctx, const TableReader& o) {
+std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& ctx,
+                                                   const TableReader& o) {
+  const fem::Mesh& mesh = ctx.model.mesh;
+  std::vector<RingShearProbe> out;
+  const auto tables = o.tables("ring_shear");
+  if (tables.size() > 1)
+    o.fail("ring_shear",
+           "give at most one [[output.ring_shear]] (its keys are max_shear_deg_q1..q4)");
+  for (const auto& t : tables) {
+    RingShearProbe rp;
+    const auto parts = t.strings("parts");
+    if (parts.size() != 2) t.fail("parts", "must name exactly 2 parts (the two plies)");
+    rp.part_a = mesh.find_part(parts[0]);
+    rp.part_b = mesh.find_part(parts[1]);
+    if (rp.part_a < 0 || rp.part_b < 0)
+      t.fail("parts", "no part named '" + parts[rp.part_a < 0 ? 0 : 1] + "'");
+    auto v3 = [&](std::string_view key, std::array<double, 3> fallback) {
+      const auto a = t.vec3_or(key, fallback);
+      return fem::V3{a[0], a[1], a[2]};
+    };
+    rp.ring.centre = v3("centre", {0, 0, 0});
+    rp.ring.axis = normalized(v3("axis", {0, 0, 1}));
+    rp.ring.zero_direction = v3("zero_direction", {1, 0, 0});
+    if (!(norm(rp.ring.axis) > 0)) t.fail("axis", "must be a non-zero vector");
+    if (norm(cross(rp.ring.axis, rp.ring.zero_direction)) < 1e-6 * norm(rp.ring.zero_direction))
+      t.fail("zero_direction", "must be non-zero and not along the ring axis");
+    rp.ring.height = t.number("height", 0.04, Range::closed(-10, 10));
+    rp.ring.step_deg = t.number("step_deg", 1.0, Range::open_closed(0, 90));
+    out.push_back(rp);
+  }
+  return out;
+}
+
+std::vector<BendingLengthProbe> read_bending_probes(const fem::CaseReadContext& ctx,
+                                                    const TableReader& o) {
   std::vector<BendingLengthProbe> out;
   for (const auto& t : o.tables("bending_length")) {
     BendingLengthProbe bp;
@@ -39,7 +74,8 @@ std::vector<BendingLengthProbe> read_bending_probes(const fem::CaseReadContext& 
 }
 
 std::optional<BiasExtensionCoupon> read_bias_extension_analytic(const TableReader& t) {
-  if (t.choice("analytic", {"none", "bias_extension"}, "none") != "bias_extension") return std::nullopt;
+  if (t.choice("analytic", {"none", "bias_extension"}, "none") != "bias_extension")
+    return std::nullopt;
   BiasExtensionCoupon c;
   c.length = t.number("coupon_length", Range::positive());
   c.width = t.number("coupon_width", Range::positive());

@@ -75,6 +75,7 @@ void read_output(const CaseReadContext& ctx, EngineCase& ec) {
   ec.output.report = o->boolean("report", false);
   for (const auto& t : o->tables("probe")) ec.probes.push_back({t.string("name"), fem::select_nodes(ctx, t, "nodes")});
   ec.shear_probes = drape::read_shear_probes(ctx, *o);
+  ec.ring_probes = drape::read_ring_shear_probes(ctx, *o);
   for (const auto& t : o->tables("mean")) ec.means.push_back(read_mean(t));
   ec.bending = drape::read_bending_probes(ctx, *o);
   for (const auto& t : o->tables("sample")) ec.samples.push_back(read_sample(t));

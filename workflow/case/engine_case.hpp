@@ -114,6 +114,7 @@ struct EngineCase {
   std::vector<PictureSpec> pictures;
   std::vector<FabricSummary> fabric_summaries;
   std::vector<ShearProbe> shear_probes;
+  std::vector<drape::RingShearProbe> ring_probes;
   std::vector<SummarySamples> samples;
   std::vector<BendingLengthProbe> bending;
   std::vector<SummaryMean> means;

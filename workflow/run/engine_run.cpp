@@ -293,6 +293,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   if (exit_code == kSuccess && r.status == "interrupted") exit_code = kOtherError;
   fill_summary(r, solver, measures, history, frames);
   r.write_summary();
+  for (const auto& m : measures)
+    for (const auto& f : m->write_files(solver, r.dir)) r.log->info("wrote {}", (r.dir / f).string());
   log_end(r, solver);
   draw_figures_and_report(r);
   r.log->info("results in {} (status: {})", r.dir.string(), r.status);

@@ -6,6 +6,7 @@
 #include "drape/probes/bias_extension_curve.hpp"
 #include "drape/probes/fabric_report.hpp"
 #include "drape/probes/picture_frame_force.hpp"
+#include "drape/probes/ring_shear_probe.hpp"
 #include "drape/probes/shear_angle_probe.hpp"
 
 namespace ncfsim::workflow {
@@ -158,6 +159,7 @@ MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s
   for (const auto& p : ec.probes) m.push_back(std::make_unique<DisplacementMeasure>(p));
   for (const auto& sp : ec.shear_probes) m.push_back(std::make_unique<drape::ShearAngleProbe>(sp, s, ec.file.string()));
   for (const auto& bp : ec.bending) m.push_back(std::make_unique<drape::BendingLengthMeasure>(bp, s));
+  for (const auto& rp : ec.ring_probes) m.push_back(std::make_unique<drape::RingShearMeasure>(rp, s));
   if (auto curve = make_bias_extension_curve(ec)) m.push_back(std::move(curve));
   m.push_back(std::make_unique<ContactResultants>());
   if (!ec.fabric_summaries.empty()) m.push_back(std::make_unique<drape::FabricReport>(ec.fabric_summaries, model));

@@ -1,0 +1,110 @@
+#include "drape/probes/ring_shear_probe.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <numeric>
+
+#include "drape/fabric_measures.hpp"
+#include "fem/elements/element_fields.hpp"
+#include "fem/elements/hex8_block.hpp"
+
+namespace ncfsim::drape {
+
+using fem::V3;
+
+RingShearMeasure::RingShearMeasure(const RingShearProbe& spec, const fem::ExplicitSolver& s)
+    : spec_(spec) {
+  auto X0 = s.x0.view();
+  double longest = 0;
+  for (int side = 0; side < 2; ++side) {
+    const int part = side == 0 ? spec.part_a : spec.part_b;
+    for (std::size_t k = 0; k < s.blocks<fem::Hex8Block>().size(); ++k) {
+      const auto& b = s.blocks<fem::Hex8Block>()[k];
+      if (b.part != part) continue;
+      for (std::size_t e = 0; e < b.n; ++e) {
+        elements_.emplace_back(k, e);
+        std::array<std::int32_t, 8> c{};
+        V3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+        for (int I = 0; I < 8; ++I) {
+          c[static_cast<std::size_t>(I)] = b.conn[static_cast<std::size_t>(I) * b.n + e];
+          const V3 p =
+              V3::at(X0.data() + 3 * static_cast<std::size_t>(c[static_cast<std::size_t>(I)]));
+          lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+          hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+        }
+        longest = std::max(longest, norm(hi - lo));
+        conn_.push_back(c);
+      }
+    }
+    if (side == 0) n_a_ = elements_.size();
+  }
+  std::vector<std::int32_t> all(conn_.size());
+  std::iota(all.begin(), all.end(), 0);
+  faces_ = outer_face_triangles(conn_, all);
+  // The nearest element of the other ply lies within one element diagonal (plies stacked).
+  reach_ = 1.5 * longest;
+}
+
+std::vector<std::string> RingShearMeasure::setup_lines() const {
+  return {fmt::format(
+      "ring shear: {} + {} tow elements, {} outer-face triangles, ring {:.4g} m above the plane",
+      n_a_, elements_.size() - n_a_, faces_.size(), spec_.ring.height)};
+}
+
+std::vector<RingSample> RingShearMeasure::ring(const fem::ExplicitSolver& s) const {
+  auto X = s.x.view();
+  const std::size_t n = elements_.size();
+  std::vector<V3> centroid(n), fibre(n);
+  std::vector<std::int32_t> a, b;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& [k, e] = elements_[i];
+    const auto& blk = s.blocks<fem::Hex8Block>()[k];
+    if (blk.n_eroded && blk.eroded[e]) continue;  // no longer part of the fabric
+    for (auto node : conn_[i])
+      centroid[i] += 0.125 * V3::at(X.data() + 3 * static_cast<std::size_t>(node));
+    double d[3];
+    fem::hex8_fibre_direction(blk, X.data(), e, d);
+    fibre[i] = {d[0], d[1], d[2]};
+    (i < n_a_ ? a : b).push_back(static_cast<std::int32_t>(i));
+  }
+  std::vector<double> shear(n, std::nan(""));
+  interply_shear_deg(centroid, fibre, a, b, reach_, shear);
+  interply_shear_deg(centroid, fibre, b, a, reach_, shear);
+  // Node values over the plies' elements, then the ring on their outer faces (mesh node ids).
+  std::vector<std::int32_t> all(a);
+  all.insert(all.end(), b.begin(), b.end());
+  const std::size_t n_nodes = s.model().mesh.n_nodes();
+  const auto node_shear = element_to_node_mean(conn_, all, shear, n_nodes);
+  std::vector<V3> x(n_nodes);
+  for (std::size_t i = 0; i < n_nodes; ++i) x[i] = V3::at(X.data() + 3 * i);
+  return ring_shear(x, faces_, node_shear, spec_.ring);
+}
+
+void RingShearMeasure::add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const {
+  const auto q = quadrant_maxima(ring(s));
+  for (std::size_t k = 0; k < 4; ++k)
+    summary[fmt::format("max_shear_deg_q{}", k + 1)] =
+        q.samples[k] > 0 ? fem::json_number(q.max_shear_deg[k]) : nullptr;
+}
+
+std::vector<std::string> RingShearMeasure::write_files(const fem::ExplicitSolver& s,
+                                                       const std::filesystem::path& dir) const {
+  std::string text = "azimuth_deg,shear_deg,hit,x_m,y_m,z_m\n";
+  for (const auto& r : ring(s))
+    text += fmt::format("{:.6g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.azimuth_deg,
+                        r.hit ? r.shear_deg : std::nan(""), r.hit ? 1 : 0, r.point.x, r.point.y,
+                        r.point.z);
+  const auto tmp = dir / "ring_shear.csv.tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << text;
+    if (!out) throw std::runtime_error((dir / "ring_shear.csv").string() + ": cannot be written");
+  }
+  std::filesystem::rename(tmp, dir / "ring_shear.csv");
+  return {"ring_shear.csv"};
+}
+
+}  // namespace ncfsim::drape

@@ -1,0 +1,35 @@
+#pragma once
+// The ring shear measure on the meso model (drape/probe_specs.hpp RingShearProbe): at every frame
+// and at the end, the inter-ply shear angle of each tow element of the two plies (against the
+// nearest element of the other ply, current positions), averaged to the nodes, read around the
+// ring on the plies' outer faces. summary.json max_shear_deg_q1..q4; ring_shear.csv at the end.
+#include <array>
+#include <utility>
+#include <vector>
+
+#include "drape/probe_specs.hpp"
+#include "fem/run_measure.hpp"
+
+namespace ncfsim::drape {
+
+class RingShearMeasure final : public fem::RunMeasure {
+ public:
+  RingShearMeasure(const RingShearProbe& spec, const fem::ExplicitSolver& s);
+  std::vector<std::string> setup_lines() const override;
+  void add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const override;
+  std::vector<std::string> write_files(const fem::ExplicitSolver& s,
+                                       const std::filesystem::path& dir) const override;
+
+  /// The ring at the solver's current state.
+  std::vector<RingSample> ring(const fem::ExplicitSolver& s) const;
+
+ private:
+  RingShearProbe spec_;
+  std::vector<std::pair<std::size_t, std::size_t>> elements_;  // (hex block, element), ply a then b
+  std::size_t n_a_ = 0;
+  std::vector<std::array<std::int32_t, 8>> conn_;   // per element of elements_
+  std::vector<std::array<std::int32_t, 3>> faces_;  // outer-face triangles (mesh nodes)
+  double reach_ = 0;                                // m, nearest-element search
+};
+
+}  // namespace ncfsim::drape

@@ -1,0 +1,114 @@
+// The meso ring measure through the case and the solver (drape/probes/ring_shear_probe.hpp): on a
+// flat, undeformed +-45 blanket the rays that meet it read zero inter-ply shear at the blanket's
+// bottom face, the quadrants without a hit are null, and [[output.ring_shear]] is read once.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "drape/probes/ring_shear_probe.hpp"
+#include "fem/errors.hpp"
+#include "fem/solver.hpp"
+#include "workflow/case/engine_case.hpp"
+
+namespace fs = std::filesystem;
+using namespace ncfsim;
+
+namespace {
+
+const char* kCase = R"(
+[case]
+name = "ring_flat"
+[mesh]
+[[mesh.fabric]]
+name = "ncf"
+origin = [0.0, 0.0, 0.0]
+size = [0.06, 0.06]
+ply_angles_deg = [45.0, -45.0]
+elements_across_tow = 1
+element_length = 6.64e-3
+tow_material = "dry_tow"
+stitch_law_I = "stitch"
+stitch_law_Lambda = "stitch"
+[[material]]
+name = "dry_tow"
+type = "tow_biphase"
+density = 1080.0
+E11f = 0.07e9
+E11m = 1.0e6
+E22m = 0.5e6
+E33m = 0.5e6
+G12m = 0.1e6
+compaction_modulus = 2.0e6
+[[bar_law]]
+name = "stitch"
+type = "tabulated"
+tension_only = true
+linear_density = 7.6e-6
+strain = [0.0, 0.1]
+force = [0.0, 2.0]
+[time]
+end_time = 1e-4
+[output]
+figures = false
+# A ring in the plane x = 30 mm about an axis along x below the blanket: azimuth 0 points up
+# (+z) through the blanket's bottom face.
+[[output.ring_shear]]
+parts = ["ncf_ply1", "ncf_ply2"]
+centre = [0.0, 0.03, -0.01]
+axis = [1.0, 0.0, 0.0]
+zero_direction = [0.0, 0.0, 1.0]
+height = 0.03
+)";
+
+fs::path write_case(const std::string& text, const std::string& name) {
+  const fs::path p =
+      fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".toml");
+  std::ofstream(p) << text;
+  return p;
+}
+
+}  // namespace
+
+TEST(RingShearProbe, FlatPlusMinus45BlanketReadsZeroShearWhereTheRaysMeetIt) {
+  const fs::path file = write_case(kCase, "ring_flat");
+  auto ec = workflow::load_engine_case(file, {});
+  ASSERT_EQ(ec.ring_probes.size(), 1u);
+  fem::ExplicitSolver solver(ec.model);
+  const drape::RingShearMeasure m(ec.ring_probes[0], solver);
+  const auto ring = m.ring(solver);
+  ASSERT_EQ(ring.size(), 360u);
+  int hits = 0;
+  for (const auto& r : ring) {
+    if (!r.hit) continue;
+    ++hits;
+    EXPECT_NEAR(r.shear_deg, 0.0, 1e-6) << r.azimuth_deg;
+    EXPECT_NEAR(r.point.x, 0.03, 1e-12);
+    // the bottom face of the lower ply, or a tow's side face where a ray slips into a tow gap
+    EXPECT_GE(r.point.z, -1e-9) << r.azimuth_deg;
+    EXPECT_LE(r.point.z, 0.47e-3) << r.azimuth_deg;
+  }
+  // atan(30 mm / 10 mm) = 71.6 deg either side of straight up meets the 60 mm blanket.
+  EXPECT_GT(hits, 2 * 65);
+  EXPECT_LT(hits, 2 * 73);
+  nlohmann::json s;
+  m.add_summary(solver, s);
+  EXPECT_NEAR(s["max_shear_deg_q1"].get<double>(), 0.0, 1e-6);
+  EXPECT_TRUE(s["max_shear_deg_q3"].is_null()) << "no ray pointing down meets the blanket";
+  fs::remove(file);
+}
+
+TEST(RingShearProbe, OnlyOneRingAndTwoPlies) {
+  std::string two =
+      std::string(kCase) + "[[output.ring_shear]]\nparts = [\"ncf_ply1\", \"ncf_ply2\"]\n";
+  const fs::path file = write_case(two, "ring_two");
+  try {
+    workflow::load_engine_case(file, {});
+    FAIL() << "two rings were accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("ring_shear"), std::string::npos) << e.what();
+  }
+  fs::remove(file);
+}
