@@ -1,4 +1,6 @@
 // The fabric-test probes of [output] and the bias-extension sample's coupon.
+#include <tuple>
+
 #include "drape/case/drape_case.hpp"
 #include "fem/case/fem_case.hpp"
 
@@ -6,18 +8,26 @@ namespace ncfsim::drape {
 
 using fem::TableReader;
 
+namespace {
+
+// `parts = [ply_a, ply_b]`: the two plies a probe compares, as part indices.
+std::pair<int, int> two_plies(const TableReader& t, const fem::Mesh& mesh) {
+  const auto parts = t.strings("parts");
+  if (parts.size() != 2) t.fail("parts", "must name exactly 2 parts (the two plies)");
+  const int a = mesh.find_part(parts[0]), b = mesh.find_part(parts[1]);
+  if (a < 0 || b < 0) t.fail("parts", "no part named '" + parts[a < 0 ? 0 : 1] + "'");
+  return {a, b};
+}
+
+}  // namespace
+
 std::vector<ShearProbe> read_shear_probes(const fem::CaseReadContext& ctx, const TableReader& o) {
   const fem::Mesh& mesh = ctx.model.mesh;
   std::vector<ShearProbe> out;
   for (const auto& t : o.tables("shear_probe")) {
     ShearProbe sp;
     sp.name = t.string("name");
-    const auto parts = t.strings("parts");
-    if (parts.size() != 2) t.fail("parts", "must name exactly 2 parts (the two plies)");
-    sp.part_a = mesh.find_part(parts[0]);
-    sp.part_b = mesh.find_part(parts[1]);
-    if (sp.part_a < 0 || sp.part_b < 0)
-      t.fail("parts", "no part named '" + parts[sp.part_a < 0 ? 0 : 1] + "'");
+    std::tie(sp.part_a, sp.part_b) = two_plies(t, mesh);
     sp.box_min = t.vec3("box_min");
     sp.box_max = t.vec3("box_max");
     out.push_back(sp);
@@ -35,12 +45,7 @@ std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& c
            "give at most one [[output.ring_shear]] (its keys are max_shear_deg_q1..q4)");
   for (const auto& t : tables) {
     RingShearProbe rp;
-    const auto parts = t.strings("parts");
-    if (parts.size() != 2) t.fail("parts", "must name exactly 2 parts (the two plies)");
-    rp.part_a = mesh.find_part(parts[0]);
-    rp.part_b = mesh.find_part(parts[1]);
-    if (rp.part_a < 0 || rp.part_b < 0)
-      t.fail("parts", "no part named '" + parts[rp.part_a < 0 ? 0 : 1] + "'");
+    std::tie(rp.part_a, rp.part_b) = two_plies(t, mesh);
     auto v3 = [&](std::string_view key, std::array<double, 3> fallback) {
       const auto a = t.vec3_or(key, fallback);
       return fem::V3{a[0], a[1], a[2]};
