@@ -55,6 +55,8 @@ struct ToolMotion {
   V3 axis{0, 0, 1};        // Force: direction of the applied force and of the free motion
   double force = 0;        // Force: magnitude (N), applied along `axis`
   double mass = 0;         // Force: tool mass (kg)
+  double pressure = 0;     // Force given as a pressure (Pa; 0: given as a force) ...
+  double pressed_area = 0; // ... over this blank area (m^2): force = pressure x area
 };
 
 struct RigidTool {

@@ -34,7 +34,8 @@ void read_tool_stl(const TableReader& t, RigidSurface& s) {
 }  // namespace
 
 void read_rigid_surface(const TableReader& t, RigidSurface& s) {
-  const std::string shape = t.choice("shape", {"plane", "sphere", "cylinder", "torus", "plane_with_hole", "stl"}, "");
+  const std::string shape =
+      t.choice("shape", {"plane", "sphere", "cylinder", "torus", "plane_with_hole", "stl"}, "");
   s.point = to_v3(t.vec3_or("point", {0, 0, 0}));
   if (t.has("axis") || shape != "stl") s.axis = unit_axis(t, "axis", {0, 0, 1});
   if (shape == "plane") s.shape = ToolShape::Plane;
@@ -46,7 +47,8 @@ void read_rigid_surface(const TableReader& t, RigidSurface& s) {
     s.radius = t.number("radius", Range::positive());
   }
   if (shape == "torus") s.minor_radius = t.number("minor_radius", Range::positive());
-  if (shape == "sphere" || shape == "cylinder" || shape == "torus") s.body_inside = t.boolean("body_inside", false);
+  if (shape == "sphere" || shape == "cylinder" || shape == "torus")
+    s.body_inside = t.boolean("body_inside", false);
   if (shape == "stl") read_tool_stl(t, s);
 }
 
@@ -61,9 +63,39 @@ void read_tool_motion(const TableReader& t, ToolMotion& m) {
   } else if (motion == "force") {
     m.kind = ToolMotion::Kind::Force;
     m.axis = unit_axis(t, "force_axis", {0, 0, -1});
-    m.force = t.number("force", Range::non_negative());
+    if (t.has("force") && t.has("pressure"))
+      t.fail("pressure", "give either force or pressure, not both");
+    if (!t.has("pressure")) m.force = t.number("force", Range::non_negative());
     m.mass = t.number("mass", Range::positive());
   }
+}
+
+// A blankholder given by its pressure: the force is the pressure over the blank area the tool
+// covers, taken as the rectangle its contact nodes span in the tool's plane less the hole (exact
+// for a rectangular blank, as the generator makes, whose corners the hole does not reach).
+double covered_area(const TableReader& t, const RigidTool& tool, const Mesh& mesh) {
+  const V3 n = tool.surface.axis;
+  V3 e1 = cross(n, std::abs(n.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0});
+  e1 = normalized(e1);
+  const V3 e2 = cross(n, e1);
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (auto node : tool.contact_nodes) {
+    const auto p = mesh.node(static_cast<std::size_t>(node));
+    const V3 r = V3{p[0], p[1], p[2]} - tool.surface.point;
+    const double u[2] = {dot(r, e1), dot(r, e2)};
+    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], u[k]), hi[k] = std::max(hi[k], u[k]);
+  }
+  double area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+  if (tool.surface.shape == ToolShape::PlaneWithHole) {
+    const double R = tool.surface.radius;
+    if (lo[0] > -R || hi[0] < R || lo[1] > -R || hi[1] < R)
+      t.fail("radius", "the hole (radius " + std::to_string(R) +
+                           " m) is not inside the blank it presses: the blank "
+                           "must be larger than the die opening");
+    area -= 3.14159265358979323846 * R * R;
+  }
+  if (!(area > 0)) t.fail("pressure", "the tool covers no blank area");
+  return area;
 }
 
 void read_tool(CaseReadContext& ctx, const TableReader& t) {
@@ -76,6 +108,14 @@ void read_tool(CaseReadContext& ctx, const TableReader& t) {
   tool.damping = t.number("damping", 0.1, Range::closed(0, 1.0));
   tool.thickness = t.number("thickness", 0.0, Range::non_negative());
   tool.contact_nodes = select_nodes(ctx, t, "contact_nodes");
+  if (tool.motion.kind == ToolMotion::Kind::Force && t.has("pressure")) {
+    if (tool.surface.shape != ToolShape::Plane && tool.surface.shape != ToolShape::PlaneWithHole)
+      t.fail("pressure", "only a plane or plane_with_hole tool presses with a pressure");
+    const double p = t.number("pressure", Range::positive());
+    tool.motion.pressure = p;
+    tool.motion.pressed_area = covered_area(t, tool, ctx.model.mesh);
+    tool.motion.force = p * tool.motion.pressed_area;
+  }
   ctx.model.tools.push_back(std::move(tool));
 }
 
@@ -90,7 +130,8 @@ Config contact_config(const CaseReadContext& ctx, const TableReader& t, const st
   return c;
 }
 
-std::unique_ptr<ContactAlgorithm> read_penalty_contact(const CaseReadContext& ctx, const TableReader& t,
+std::unique_ptr<ContactAlgorithm> read_penalty_contact(const CaseReadContext& ctx,
+                                                       const TableReader& t,
                                                        const std::string& name) {
   auto c = contact_config<PenaltyContactConfig>(ctx, t, name);
   c.penalty_scale = t.number("penalty_scale", c.penalty_scale, {});
@@ -109,7 +150,8 @@ std::unique_ptr<ContactAlgorithm> read_penalty_contact(const CaseReadContext& ct
   }
   for (const auto& pr : t.tables("pair")) {
     const auto names = pr.strings("groups");
-    if (names.size() != 2) pr.fail("groups", "must name exactly 2 groups (the same twice for self-contact)");
+    if (names.size() != 2)
+      pr.fail("groups", "must name exactly 2 groups (the same twice for self-contact)");
     ContactPair cp;
     for (std::size_t k = 0; k < 2; ++k) {
       const auto it = groups.find(names[k]);
@@ -122,8 +164,8 @@ std::unique_ptr<ContactAlgorithm> read_penalty_contact(const CaseReadContext& ct
   return std::make_unique<PenaltyContact>(std::move(c));
 }
 
-std::unique_ptr<ContactAlgorithm> read_tied_contact(const CaseReadContext& ctx, const TableReader& t,
-                                                    const std::string& name) {
+std::unique_ptr<ContactAlgorithm> read_tied_contact(const CaseReadContext& ctx,
+                                                    const TableReader& t, const std::string& name) {
   auto c = contact_config<TiedContactConfig>(ctx, t, name);
   c.slave = {name + "_slave", part_indices(t, "slave_parts", ctx.model.mesh)};
   c.master = {name + "_master", part_indices(t, "master_parts", ctx.model.mesh)};

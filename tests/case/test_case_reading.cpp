@@ -3,6 +3,7 @@
 // is checked once, under the key's own name (the contact pair friction, [0, 10]).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -83,7 +84,8 @@ name = "b"
 parts = ["upper"]
 [[contact.pair]]
 groups = ["a", "b"]
-)" + pair + R"(
+)" + pair +
+         R"(
 [time]
 end_time = 1e-4
 )";
@@ -96,16 +98,20 @@ TEST(CaseTypeRegistry, DispatchesAMaterialTypeToItsReader) {
   fem::register_fem_case_types(registry);
   int calls = 0;
   double density_seen = 0;
-  registry.add_material_type("test_law", [&](const fem::TableReader& t, const std::string& name, double rho) {
-    ++calls;
-    density_seen = rho;
-    return std::make_unique<fem::ElasticIsotropic>(name, rho, t.number("youngs_modulus", Range::positive()),
-                                                   t.number("poisson_ratio", Range{}));
-  });
-  EXPECT_EQ(registry.material_types(), (std::vector<std::string>{"elastic_isotropic", "elastic_orthotropic", "test_law"}));
+  registry.add_material_type("test_law",
+                             [&](const fem::TableReader& t, const std::string& name, double rho) {
+                               ++calls;
+                               density_seen = rho;
+                               return std::make_unique<fem::ElasticIsotropic>(
+                                   name, rho, t.number("youngs_modulus", Range::positive()),
+                                   t.number("poisson_ratio", Range{}));
+                             });
+  EXPECT_EQ(registry.material_types(),
+            (std::vector<std::string>{"elastic_isotropic", "elastic_orthotropic", "test_law"}));
   EXPECT_THROW(registry.add_material_type("test_law", {}), std::logic_error);
 
-  fem::CaseDocument doc = fem::CaseDocument::load(write_case("dispatch", material_case("test_law")), {});
+  fem::CaseDocument doc =
+      fem::CaseDocument::load(write_case("dispatch", material_case("test_law")), {});
   const fem::TableReader root(doc, doc.root(), "");
   const auto material = registry.read_material(root.tables("material").at(0), "m");
   EXPECT_EQ(calls, 1);
@@ -116,7 +122,8 @@ TEST(CaseTypeRegistry, DispatchesAMaterialTypeToItsReader) {
 
 TEST(CaseTypeRegistry, EngineCasesKnowDrapesTowLaw) {
   const auto types = workflow::engine_case_types().material_types();
-  EXPECT_EQ(types, (std::vector<std::string>{"elastic_isotropic", "elastic_orthotropic", "tow_biphase"}));
+  EXPECT_EQ(types,
+            (std::vector<std::string>{"elastic_isotropic", "elastic_orthotropic", "tow_biphase"}));
 }
 
 TEST(CaseTypeRegistry, UnknownTypeNamesFileKeyAndTheAllowedTypes) {
@@ -139,7 +146,8 @@ TEST(CaseTypeRegistry, UnknownTypeNamesFileKeyAndTheAllowedTypes) {
 }
 
 TEST(CaseReading, ContactFrictionOutOfRangeNamesItsKeyOnce) {
-  EXPECT_NO_THROW(workflow::load_engine_case(write_case("mu_ok", contact_case("friction = 10.0")), {}));
+  EXPECT_NO_THROW(
+      workflow::load_engine_case(write_case("mu_ok", contact_case("friction = 10.0")), {}));
   for (const char* bad : {"friction = 10.5", "friction = -0.1"}) {
     const fs::path file = write_case("mu_bad", contact_case(bad));
     try {
@@ -158,9 +166,41 @@ TEST(CaseReading, ContactFrictionOutOfRangeNamesItsKeyOnce) {
 
 TEST(CaseReading, ReadsAreIndependent) {
   // Nothing is kept from one case to the next (the tow-end pins live in the reading context).
-  const auto a = workflow::load_engine_case(write_case("independent", contact_case("friction = 0.2")), {});
-  const auto b = workflow::load_engine_case(write_case("independent", contact_case("friction = 0.2")), {});
+  const auto a =
+      workflow::load_engine_case(write_case("independent", contact_case("friction = 0.2")), {});
+  const auto b =
+      workflow::load_engine_case(write_case("independent", contact_case("friction = 0.2")), {});
   EXPECT_EQ(a.model.mesh.coords, b.model.mesh.coords);
   EXPECT_EQ(a.model.contacts.size(), 1u);
   EXPECT_EQ(b.model.contacts.size(), 1u);
+}
+
+// A blankholder given by its pressure presses with the pressure over the blank area it covers:
+// the 240 mm square blank of the hemisphere case less the 99 mm hole, 3.35 kPa.
+TEST(CaseReading, BlankholderPressureGivesTheForceOverTheCoveredArea) {
+  const std::filesystem::path file =
+      std::filesystem::path(NCFSIM_SOURCE_DIR) / "cases/hemisphere/drape.toml";
+  const std::vector<std::string> ci{
+      "mesh.fabric[0].elements_across_tow=1", "mesh.fabric[0].element_length=6.64e-3",
+      "mesh.fabric[0].size=[0.24,0.24]", "mesh.fabric[0].origin=[-0.12,-0.12,0.0]"};
+  const auto ec = workflow::load_engine_case(file, ci);
+  const auto& bh = ec.model.tools.at(1);
+  ASSERT_EQ(bh.name, "blankholder");
+  const double area = 0.24 * 0.24 - M_PI * 0.099 * 0.099;
+  EXPECT_NEAR(bh.motion.pressed_area, area, 1e-9 * area);
+  EXPECT_NEAR(bh.motion.force, 3350.0 * area, 1e-9 * 3350.0 * area);
+  auto expect_key = [&](std::vector<std::string> extra, const std::string& key) {
+    auto o = ci;
+    o.insert(o.end(), extra.begin(), extra.end());
+    try {
+      workflow::load_engine_case(file, o);
+      ADD_FAILURE() << "accepted: " << extra[0];
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+    }
+  };
+  expect_key({"tool[1].pressure=0.0"}, "tool[1].pressure");
+  expect_key({"tool[1].force=10.0"}, "tool[1].pressure");  // both given
+  expect_key({"mesh.fabric[0].size=[0.15,0.15]", "mesh.fabric[0].origin=[-0.075,-0.075,0.0]"},
+             "tool[1].radius");
 }

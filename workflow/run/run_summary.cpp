@@ -46,6 +46,13 @@ void describe_model(const fem::ExplicitSolver& solver, spdlog::logger& log, json
     parts[pm.part] = {
         {"mass_kg", pm.mass}, {"added_mass_kg", pm.added_mass}, {"added_mass_percent", pct}};
   }
+  for (const auto& t : model.tools)
+    if (t.motion.pressure > 0) {
+      log.info("tool {}: {:.4g} Pa over the {:.5g} m^2 of blank it covers: {:.5g} N", t.name,
+               t.motion.pressure, t.motion.pressed_area, t.motion.force);
+      summary[t.name + "_pressed_area_m2"] = t.motion.pressed_area;
+      summary[t.name + "_applied_force_N"] = t.motion.force;
+    }
   log.info("end time {:.4g} s: about {:.3g} cycles", model.time.end_time,
            model.time.end_time / solver.time_step());
   summary["elements"] = nlohmann::json::object();
