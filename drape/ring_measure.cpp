@@ -1,5 +1,7 @@
 #include "drape/ring_measure.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -79,6 +81,15 @@ std::vector<RingSample> ring_shear(const std::vector<V3>& nodes,
     }
   }
   return out;
+}
+
+std::string ring_csv(const std::vector<RingSample>& ring, const std::string& shear_column) {
+  std::string s = "azimuth_deg," + shear_column + ",hit,x_m,y_m,z_m\n";
+  for (const auto& r : ring)
+    s += fmt::format("{:.6g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.azimuth_deg,
+                     r.hit ? r.shear_deg : std::nan(""), r.hit ? 1 : 0, r.point.x, r.point.y,
+                     r.point.z);
+  return s;
 }
 
 QuadrantMaxima quadrant_maxima(const std::vector<RingSample>& ring) {

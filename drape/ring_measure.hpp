@@ -11,6 +11,7 @@
 // and its value is interpolated from the triangle's nodes.
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "fem/vec3.hpp"
@@ -37,6 +38,10 @@ struct RingSample {
 std::vector<RingSample> ring_shear(const std::vector<fem::V3>& nodes,
                                    const std::vector<std::array<std::int32_t, 3>>& triangles,
                                    const std::vector<double>& node_shear_deg, const RingSpec& ring);
+
+/// The ring as CSV text: azimuth_deg,<shear_column>,hit,x_m,y_m,z_m (NaN shear where the ray
+/// misses): ring_shear.csv of the meso runs and of the kinematic drape.
+std::string ring_csv(const std::vector<RingSample>& ring, const std::string& shear_column);
 
 struct QuadrantMaxima {
   std::array<double, 4> max_shear_deg{0, 0, 0, 0};  // q1..q4

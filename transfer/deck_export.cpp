@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fem/io/atomic_file.hpp"
+
 namespace ncfsim::transfer {
 
 namespace {
@@ -16,20 +18,6 @@ constexpr int kFace[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
 // Abaqus C3D8 face labels S1..S6 for the same faces (S1: 1-2-3-4, S2: 5-8-7-6, S3: 1-5-6-2,
 // S4: 2-6-7-3, S5: 3-7-8-4, S6: 4-8-5-1).
 constexpr int kAbaqusFace[6] = {1, 2, 3, 4, 5, 6};
-
-void write_atomically(const std::filesystem::path& file, const std::string& text) {
-  const auto tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(file.string() + ": cannot be written");
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error(file.string() + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
-}
 
 void check(const ExportModel& m) {
   const std::size_t n = m.hex.size();
@@ -85,7 +73,7 @@ void write_abaqus_inp(const std::filesystem::path& file, const ExportModel& m) {
     }
     s += fmt::format("*TIE, NAME={}, ADJUST=NO\n{}_slave, {}_master\n", t.name, t.name, t.name);
   }
-  write_atomically(file, s);
+  fem::io::atomic_write_text(file, s);
 }
 
 void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& m) {
@@ -135,7 +123,7 @@ void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& 
         set / 2, t.name, ids[0], ids[1], 0, 0);
   }
   s += "*END\n";
-  write_atomically(file, s);
+  fem::io::atomic_write_text(file, s);
 }
 
 DeckCounts read_deck(const std::filesystem::path& file, const std::string& format) {

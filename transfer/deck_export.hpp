@@ -38,7 +38,7 @@ struct ExportModel {
   std::vector<ExportTie> ties;
 };
 
-/// Write atomically (temporary file + rename); throw std::runtime_error naming the file.
+/// Written atomically (fem/io/atomic_file.hpp); throw std::runtime_error naming the file.
 void write_abaqus_inp(const std::filesystem::path& file, const ExportModel& m);
 void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& m);
 

@@ -37,13 +37,20 @@ void renumber_fabrics(fem::CaseReadContext& ctx, std::vector<FabricEntry>& fabri
                       const std::vector<std::int32_t>& new_of_old);
 /// After fem::read_parts: the properties of the fabrics' parts (tow material, ply axes, stitch
 /// laws) and their stitch-to-tow connections (into ctx.model.contacts).
-std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx, const std::vector<FabricEntry>& fabrics);
+std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx,
+                                               const std::vector<FabricEntry>& fabrics);
 
 /// [[output.shear_probe]] and [[output.bending_length]] of the [output] table `o`.
-std::vector<ShearProbe> read_shear_probes(const fem::CaseReadContext& ctx, const fem::TableReader& o);
+std::vector<ShearProbe> read_shear_probes(const fem::CaseReadContext& ctx,
+                                          const fem::TableReader& o);
+/// The ring keys (centre, axis, zero_direction, height, step_deg) of a table: the ring measure
+/// of [[output.ring_shear]] and of a kinematic drape's [ring].
+void read_ring(const fem::TableReader& t, RingSpec& ring);
 /// [[output.ring_shear]] (at most one).
-std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& ctx, const fem::TableReader& o);
-std::vector<BendingLengthProbe> read_bending_probes(const fem::CaseReadContext& ctx, const fem::TableReader& o);
+std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& ctx,
+                                                   const fem::TableReader& o);
+std::vector<BendingLengthProbe> read_bending_probes(const fem::CaseReadContext& ctx,
+                                                    const fem::TableReader& o);
 
 /// The bias-extension coupon of an [[output.sample]] with analytic = "bias_extension" (else none).
 struct BiasExtensionCoupon {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "drape/case/drape_case.hpp"
 #include "fem/case/fem_case.hpp"
 #include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
@@ -15,27 +16,8 @@ using fem::V3;
 
 constexpr double kPi = 3.14159265358979323846;
 
-V3 unit(const TableReader& t, std::string_view key, std::array<double, 3> fallback) {
-  const auto a = t.vec3_or(key, fallback);
-  const V3 v{a[0], a[1], a[2]};
-  if (!(norm(v) > 0)) t.fail(key, "must be a non-zero vector");
-  return normalized(v);
-}
-
-void read_ring(const TableReader& r, RingSpec& ring) {
-  const auto c = r.vec3_or("centre", {0, 0, 0});
-  ring.centre = {c[0], c[1], c[2]};
-  ring.axis = unit(r, "axis", {0, 0, 1});
-  ring.zero_direction = unit(r, "zero_direction", {1, 0, 0});
-  if (norm(cross(ring.axis, ring.zero_direction)) < 1e-6)
-    r.fail("zero_direction", "must not be parallel to the ring axis");
-  ring.height = r.number("height", 0.04, Range::closed(-10, 10));
-  ring.step_deg = r.number("step_deg", 1.0, Range::open_closed(0.0, 90.0));
-}
-
 void read_net(const TableReader& n, KinematicDrapeCase& kc) {
-  const auto pole = n.vec3("pole");
-  kc.net.pole = {pole[0], pole[1], pole[2]};
+  kc.net.pole = V3::from(n.vec3("pole"));
   kc.net.spacing = n.number("spacing", 2e-3, Range::open_closed(0.0, 0.1));
   const double reach = n.number("reach", Range::positive());
   const double half = std::ceil(reach / kc.net.spacing);
@@ -70,10 +52,7 @@ KinematicDrapeCase load_kinematic_drape_case(const std::filesystem::path& file,
   kc.file = file;
   kc.overrides = overrides;
   const TableReader c = root.required_table("case");
-  kc.name = c.string("name");
-  if (kc.name.empty() || kc.name.find_first_of("/\\ ") != std::string::npos)
-    c.fail("name",
-           "must be a non-empty name without spaces or slashes (it names the output folder)");
+  kc.name = fem::read_case_name(c);
   c.choice("kind", {"kinematic_drape"}, "");
   kc.description = c.string("description", "");
   const auto surfaces = root.tables("surface");

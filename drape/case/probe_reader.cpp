@@ -35,6 +35,16 @@ std::vector<ShearProbe> read_shear_probes(const fem::CaseReadContext& ctx, const
   return out;
 }
 
+void read_ring(const TableReader& t, RingSpec& ring) {
+  ring.centre = fem::V3::from(t.vec3_or("centre", {0, 0, 0}));
+  ring.axis = fem::read_unit_vector(t, "axis", {0, 0, 1});
+  ring.zero_direction = fem::read_unit_vector(t, "zero_direction", {1, 0, 0});
+  if (norm(cross(ring.axis, ring.zero_direction)) < 1e-6)
+    t.fail("zero_direction", "must not be along the ring axis");
+  ring.height = t.number("height", 0.04, Range::closed(-10, 10));
+  ring.step_deg = t.number("step_deg", 1.0, Range::open_closed(0, 90));
+}
+
 std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& ctx,
                                                    const TableReader& o) {
   const fem::Mesh& mesh = ctx.model.mesh;
@@ -46,18 +56,7 @@ std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& c
   for (const auto& t : tables) {
     RingShearProbe rp;
     std::tie(rp.part_a, rp.part_b) = two_plies(t, mesh);
-    auto v3 = [&](std::string_view key, std::array<double, 3> fallback) {
-      const auto a = t.vec3_or(key, fallback);
-      return fem::V3{a[0], a[1], a[2]};
-    };
-    rp.ring.centre = v3("centre", {0, 0, 0});
-    rp.ring.axis = normalized(v3("axis", {0, 0, 1}));
-    rp.ring.zero_direction = v3("zero_direction", {1, 0, 0});
-    if (!(norm(rp.ring.axis) > 0)) t.fail("axis", "must be a non-zero vector");
-    if (norm(cross(rp.ring.axis, rp.ring.zero_direction)) < 1e-6 * norm(rp.ring.zero_direction))
-      t.fail("zero_direction", "must be non-zero and not along the ring axis");
-    rp.ring.height = t.number("height", 0.04, Range::closed(-10, 10));
-    rp.ring.step_deg = t.number("step_deg", 1.0, Range::open_closed(0, 90));
+    read_ring(t, rp.ring);
     out.push_back(rp);
   }
   return out;

@@ -4,12 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <numeric>
 
 #include "drape/fabric_measures.hpp"
 #include "fem/elements/element_fields.hpp"
 #include "fem/elements/hex8_block.hpp"
+#include "fem/io/atomic_file.hpp"
 
 namespace ncfsim::drape {
 
@@ -92,18 +92,7 @@ void RingShearMeasure::add_summary(const fem::ExplicitSolver& s, nlohmann::json&
 
 std::vector<std::string> RingShearMeasure::write_files(const fem::ExplicitSolver& s,
                                                        const std::filesystem::path& dir) const {
-  std::string text = "azimuth_deg,shear_deg,hit,x_m,y_m,z_m\n";
-  for (const auto& r : ring(s))
-    text += fmt::format("{:.6g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.azimuth_deg,
-                        r.hit ? r.shear_deg : std::nan(""), r.hit ? 1 : 0, r.point.x, r.point.y,
-                        r.point.z);
-  const auto tmp = dir / "ring_shear.csv.tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << text;
-    if (!out) throw std::runtime_error((dir / "ring_shear.csv").string() + ": cannot be written");
-  }
-  std::filesystem::rename(tmp, dir / "ring_shear.csv");
+  fem::io::atomic_write_text(dir / "ring_shear.csv", ring_csv(ring(s), "shear_deg"));
   return {"ring_shear.csv"};
 }
 

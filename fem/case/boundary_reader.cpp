@@ -7,13 +7,13 @@ namespace ncfsim::fem {
 
 namespace {
 
-V3 to_v3(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
-
-std::array<bool, 3> read_dofs(const TableReader& t, std::string_view key, std::array<bool, 3> fallback) {
+std::array<bool, 3> read_dofs(const TableReader& t, std::string_view key,
+                              std::array<bool, 3> fallback) {
   if (!t.has(key)) return fallback;
   std::array<bool, 3> d{false, false, false};
   for (const auto& s : t.strings(key)) {
-    if (s != "x" && s != "y" && s != "z") t.fail(key, "'" + s + "' is not an axis; one of 'x', 'y', 'z'");
+    if (s != "x" && s != "y" && s != "z")
+      t.fail(key, "'" + s + "' is not an axis; one of 'x', 'y', 'z'");
     d[static_cast<std::size_t>(s[0] - 'x')] = true;
   }
   return d;
@@ -31,7 +31,7 @@ Set read_constraint_set(const CaseReadContext& ctx, const TableReader& t) {
 
 void read_velocity(CaseReadContext& ctx, const TableReader& t) {
   auto pv = read_constraint_set<PrescribedVelocity>(ctx, t);
-  pv.velocity = to_v3(t.vec3("velocity"));
+  pv.velocity = V3::from(t.vec3("velocity"));
   pv.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
   pv.start_time = t.number("start_time", 0.0, Range::non_negative());
   ctx.model.velocities.push_back(std::move(pv));
@@ -41,8 +41,8 @@ void read_picture_frame(CaseReadContext& ctx, const TableReader& t) {
   PictureFrame pf;
   pf.name = t.string("name");
   pf.nodes = select_nodes(ctx, t, "nodes");
-  pf.corner = to_v3(t.vec3("corner"));
-  V3 a1 = to_v3(t.vec3_or("arm1", {1, 0, 0})), a2 = to_v3(t.vec3_or("arm2", {0, 1, 0}));
+  pf.corner = V3::from(t.vec3("corner"));
+  V3 a1 = V3::from(t.vec3_or("arm1", {1, 0, 0})), a2 = V3::from(t.vec3_or("arm2", {0, 1, 0}));
   if (!(norm(a1) > 0) || !(norm(a2) > 0)) t.fail("arm1", "arms must not be zero");
   a1 = normalized(a1), a2 = normalized(a2);
   if (std::abs(dot(a1, a2)) > 1e-6) t.fail("arm2", "must be orthogonal to arm1");
@@ -52,7 +52,8 @@ void read_picture_frame(CaseReadContext& ctx, const TableReader& t) {
   if (t.has("wall_nodes_arm1")) pf.walls[0] = select_nodes(ctx, t, "wall_nodes_arm1");
   if (t.has("wall_nodes_arm2")) pf.walls[1] = select_nodes(ctx, t, "wall_nodes_arm2");
   pf.wall_penalty_scale = t.number("wall_penalty_scale", 0.1, Range::open_closed(0, 1));
-  ctx.frame_final_angles.push_back(t.number("final_shear_angle_deg", Range::open_closed(0, 80)) * M_PI / 180.0);
+  ctx.frame_final_angles.push_back(t.number("final_shear_angle_deg", Range::open_closed(0, 80)) *
+                                   M_PI / 180.0);
   ctx.frame_fabric_length.push_back(t.number("fabric_length", pf.arm_length, Range::positive()));
   ctx.model.picture_frames.push_back(std::move(pf));
 }
@@ -62,7 +63,8 @@ void read_picture_frame(CaseReadContext& ctx, const TableReader& t) {
 void read_boundary(CaseReadContext& ctx) {
   const auto bc = ctx.root.table("boundary");
   if (!bc) return;
-  for (const auto& t : bc->tables("fixed")) ctx.model.fixed.push_back(read_constraint_set<FixedDofs>(ctx, t));
+  for (const auto& t : bc->tables("fixed"))
+    ctx.model.fixed.push_back(read_constraint_set<FixedDofs>(ctx, t));
   for (const auto& t : bc->tables("velocity")) read_velocity(ctx, t);
   for (const auto& t : bc->tables("picture_frame")) read_picture_frame(ctx, t);
 }
@@ -70,13 +72,14 @@ void read_boundary(CaseReadContext& ctx) {
 void read_loads(CaseReadContext& ctx) {
   Model& model = ctx.model;
   if (auto ld = ctx.root.table("load")) {
-    model.gravity = to_v3(ld->vec3_or("gravity", {0, 0, 0}));
+    model.gravity = V3::from(ld->vec3_or("gravity", {0, 0, 0}));
     model.gravity_ramp_time = ld->number("gravity_ramp_time", 0.0, Range::non_negative());
     for (const auto& t : ld->tables("nodal_force")) {
       NodalLoad l;
       l.name = t.string("name");
       l.nodes = select_nodes(ctx, t, "nodes");
-      l.force_per_node = (1.0 / static_cast<double>(l.nodes.size())) * to_v3(t.vec3("total_force"));
+      l.force_per_node =
+          (1.0 / static_cast<double>(l.nodes.size())) * V3::from(t.vec3("total_force"));
       l.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
       model.loads.push_back(std::move(l));
     }
@@ -87,7 +90,8 @@ void read_loads(CaseReadContext& ctx) {
   }
   if (auto init = ctx.root.table("initial"))
     for (const auto& t : init->tables("velocity"))
-      model.initial_velocities.push_back({select_nodes(ctx, t, "nodes"), to_v3(t.vec3("velocity"))});
+      model.initial_velocities.push_back(
+          {select_nodes(ctx, t, "nodes"), V3::from(t.vec3("velocity"))});
 }
 
 void read_time(CaseReadContext& ctx) {
@@ -102,11 +106,14 @@ void read_time(CaseReadContext& ctx) {
   time.energy_balance_limit = tc.number("energy_balance_limit", 0.05, Range::open_closed(0, 1));
   time.erosion_step_ratio = tc.number("erosion_step_ratio", 0.0, Range{0, 1, false, true});
   if (time.erosion_step_ratio > 0 && time.erosion_step_ratio <= time.min_step_ratio)
-    tc.fail("erosion_step_ratio", "must be 0 (off) or above " + std::to_string(time.min_step_ratio) +
+    tc.fail("erosion_step_ratio", "must be 0 (off) or above " +
+                                      std::to_string(time.min_step_ratio) +
                                       ", the share of the initial step at which a run stops");
-  for (std::size_t k = 0; k < ctx.model.picture_frames.size(); ++k) {  // constant rate to the final angle at end_time
+  for (std::size_t k = 0; k < ctx.model.picture_frames.size();
+       ++k) {  // constant rate to the final angle at end_time
     auto& pf = ctx.model.picture_frames[k];
-    if (!(time.end_time > pf.ramp_time)) tc.fail("end_time", "must exceed the picture frame's ramp_time");
+    if (!(time.end_time > pf.ramp_time))
+      tc.fail("end_time", "must exceed the picture frame's ramp_time");
     pf.shear_rate = ctx.frame_final_angles[k] / (time.end_time - 0.5 * pf.ramp_time);
   }
 }

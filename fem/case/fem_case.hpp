@@ -35,7 +35,13 @@ void read_rigid_surface(const TableReader& t, RigidSurface& s);
 void read_time(CaseReadContext& ctx);
 
 /// A node selection `key = { ... }` of table `owner` (docs/case-file.md, "Node selections").
-std::vector<std::int32_t> select_nodes(const CaseReadContext& ctx, const TableReader& owner, std::string_view key);
+std::vector<std::int32_t> select_nodes(const CaseReadContext& ctx, const TableReader& owner,
+                                       std::string_view key);
+/// A direction `key` (default `fallback`), normalised; zero is bad input.
+V3 read_unit_vector(const TableReader& t, std::string_view key, std::array<double, 3> fallback);
+/// `[case] name` (`case_table` is the [case] table): non-empty, no spaces or slashes (it names
+/// the output folder). Every stage's case has one.
+std::string read_case_name(const TableReader& case_table);
 /// Part names under `key` as indices into mesh.part_names (at least one).
 std::vector<int> part_indices(const TableReader& t, std::string_view key, const Mesh& mesh);
 

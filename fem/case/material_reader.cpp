@@ -7,15 +7,15 @@ namespace ncfsim::fem {
 
 namespace {
 
-V3 to_v3(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
-
-std::unique_ptr<SolidMaterial> read_elastic_isotropic(const TableReader& t, const std::string& name, double rho) {
+std::unique_ptr<SolidMaterial> read_elastic_isotropic(const TableReader& t, const std::string& name,
+                                                      double rho) {
   const double E = t.number("youngs_modulus", Range::positive());
   const double nu = t.number("poisson_ratio", {-1.0, 0.5, true, true});
   return std::make_unique<ElasticIsotropic>(name, rho, E, nu);
 }
 
-std::unique_ptr<SolidMaterial> read_elastic_orthotropic(const TableReader& t, const std::string& name, double rho) {
+std::unique_ptr<SolidMaterial> read_elastic_orthotropic(const TableReader& t,
+                                                        const std::string& name, double rho) {
   OrthotropicConstants c{};
   c.E1 = t.number("E1", Range::positive());
   c.E2 = t.number("E2", Range::positive());
@@ -35,7 +35,8 @@ BarForceLaw read_bar_law(const TableReader& t, const std::string& name) {
   const bool tension_only = t.boolean("tension_only", false);
   try {
     if (type == "linear")
-      return BarForceLaw::linear(name, t.number("axial_stiffness", Range::positive()), tension_only, rho_l);
+      return BarForceLaw::linear(name, t.number("axial_stiffness", Range::positive()), tension_only,
+                                 rho_l);
     auto strain = t.numbers("strain", {}, 2);
     auto force = t.numbers("force", {}, 2);
     if (strain.size() != force.size()) t.fail("force", "needs as many values as `strain`");
@@ -47,8 +48,8 @@ BarForceLaw read_bar_law(const TableReader& t, const std::string& name) {
 
 std::array<double, 9> read_axes(const TableReader& t) {
   if (!t.has("material_axis_1") && !t.has("material_axis_2")) return kIdentityAxes;
-  auto a = to_v3(t.vec3("material_axis_1"));
-  auto b = to_v3(t.vec3_or("material_axis_2", {0, 1, 0}));
+  auto a = V3::from(t.vec3("material_axis_1"));
+  auto b = V3::from(t.vec3_or("material_axis_2", {0, 1, 0}));
   const double na = norm(a);
   if (!(na > 0)) t.fail("material_axis_1", "must not be zero");
   a = (1.0 / na) * a;
@@ -66,7 +67,8 @@ void read_part(CaseReadContext& ctx, const TableReader& t) {
   const int p = mesh.find_part(name);
   if (p < 0) t.fail("name", "no mesh block or line uses part '" + name + "'");
   if (const auto g = ctx.generated_parts.find(name); g != ctx.generated_parts.end())
-    t.fail("name", "part '" + name + "' belongs to a " + g->second + ": its properties come from there");
+    t.fail("name",
+           "part '" + name + "' belongs to a " + g->second + ": its properties come from there");
   auto& pp = ctx.model.parts[static_cast<std::size_t>(p)];
   ctx.part_defined[static_cast<std::size_t>(p)] = 1;
   if (ctx.part_kind[name] == PartKind::Solid) {
@@ -97,7 +99,8 @@ std::vector<std::string> CaseTypeRegistry::material_types() const {
   return out;
 }
 
-std::unique_ptr<SolidMaterial> CaseTypeRegistry::read_material(const TableReader& t, const std::string& name) const {
+std::unique_ptr<SolidMaterial> CaseTypeRegistry::read_material(const TableReader& t,
+                                                               const std::string& name) const {
   const std::string type = t.choice("type", material_types(), "");
   const double rho = t.number("density", Range::positive());
   for (const auto& [known, reader] : materials_)
@@ -142,7 +145,8 @@ void read_parts(CaseReadContext& ctx) {
 void check_parts_defined(const CaseReadContext& ctx) {
   for (std::size_t p = 0; p < ctx.part_defined.size(); ++p)
     if (!ctx.part_defined[p])
-      ctx.root.fail("part", "part '" + ctx.model.mesh.part_names[p] + "' has no [[part]] entry (material)");
+      ctx.root.fail("part",
+                    "part '" + ctx.model.mesh.part_names[p] + "' has no [[part]] entry (material)");
 }
 
 }  // namespace ncfsim::fem

@@ -26,7 +26,8 @@ int axis_index(const TableReader& t, std::string_view key, const std::string& va
 int use_part(CaseReadContext& ctx, const TableReader& t, const std::string& part, PartKind kind) {
   const auto it = ctx.part_kind.find(part);
   if (it != ctx.part_kind.end() && it->second != kind)
-    t.fail("part", "'" + part + "' already holds " + (kind == PartKind::Solid ? "bars" : "hexahedra"));
+    t.fail("part",
+           "'" + part + "' already holds " + (kind == PartKind::Solid ? "bars" : "hexahedra"));
   ctx.part_kind[part] = kind;
   Mesh& mesh = ctx.model.mesh;
   const int p = mesh.find_part(part);
@@ -130,9 +131,24 @@ void keep_named_set(const TableReader& sel, const std::string& key, const NamedN
 
 }  // namespace
 
+V3 read_unit_vector(const TableReader& t, std::string_view key, std::array<double, 3> fallback) {
+  const V3 ax = V3::from(t.vec3_or(key, fallback));
+  if (!(norm(ax) > 0)) t.fail(key, "must not be zero");
+  return (1.0 / norm(ax)) * ax;
+}
+
+std::string read_case_name(const TableReader& case_table) {
+  std::string name = case_table.string("name");
+  if (name.empty() || name.find_first_of("/\\ ") != std::string::npos)
+    case_table.fail(
+        "name", "must be a non-empty name without spaces or slashes (it names the output folder)");
+  return name;
+}
+
 std::vector<char> part_node_mask(const Mesh& mesh, int part) {
   std::vector<char> in_part(mesh.n_nodes(), 0);
-  mesh.for_each_element_node(part, [&](std::int32_t node) { in_part[static_cast<std::size_t>(node)] = 1; });
+  mesh.for_each_element_node(
+      part, [&](std::int32_t node) { in_part[static_cast<std::size_t>(node)] = 1; });
   return in_part;
 }
 
@@ -156,10 +172,13 @@ std::vector<std::int32_t> finish_mesh(CaseReadContext& ctx) {
 }
 
 // Node selection: the intersection of the criteria given (part, box, plane, outline, named sets).
-std::vector<std::int32_t> select_nodes(const CaseReadContext& ctx, const TableReader& owner, std::string_view key) {
+std::vector<std::int32_t> select_nodes(const CaseReadContext& ctx, const TableReader& owner,
+                                       std::string_view key) {
   auto sel = owner.table(key);
-  if (!sel) owner.fail(key, "missing (required node selection, e.g. { part = \"beam\" } or "
-                            "{ axis = \"x\", value = 0.0 })");
+  if (!sel)
+    owner.fail(key,
+               "missing (required node selection, e.g. { part = \"beam\" } or "
+               "{ axis = \"x\", value = 0.0 })");
   const Mesh& mesh = ctx.model.mesh;
   std::vector<char> keep(mesh.n_nodes(), 1);
   bool any = false;
@@ -174,7 +193,8 @@ std::vector<std::int32_t> select_nodes(const CaseReadContext& ctx, const TableRe
     any = true;
     if (!sel->boolean("all", false)) sel->fail("all", "only `all = true` is meaningful");
   }
-  if (!any) owner.fail(key, "selects nothing: give part, box_min/box_max, axis/value or all = true");
+  if (!any)
+    owner.fail(key, "selects nothing: give part, box_min/box_max, axis/value or all = true");
   std::vector<std::int32_t> out;
   for (std::size_t i = 0; i < keep.size(); ++i)
     if (keep[i]) out.push_back(static_cast<std::int32_t>(i));

@@ -10,14 +10,6 @@ namespace ncfsim::fem {
 
 namespace {
 
-V3 to_v3(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
-
-V3 unit_axis(const TableReader& t, std::string_view key, std::array<double, 3> fallback) {
-  const V3 ax = to_v3(t.vec3_or(key, fallback));
-  if (!(norm(ax) > 0)) t.fail(key, "must not be zero");
-  return (1.0 / norm(ax)) * ax;
-}
-
 void read_tool_stl(const TableReader& t, RigidSurface& s) {
   s.shape = ToolShape::Triangles;
   std::filesystem::path stl = t.string("file");
@@ -36,8 +28,8 @@ void read_tool_stl(const TableReader& t, RigidSurface& s) {
 void read_rigid_surface(const TableReader& t, RigidSurface& s) {
   const std::string shape =
       t.choice("shape", {"plane", "sphere", "cylinder", "torus", "plane_with_hole", "stl"}, "");
-  s.point = to_v3(t.vec3_or("point", {0, 0, 0}));
-  if (t.has("axis") || shape != "stl") s.axis = unit_axis(t, "axis", {0, 0, 1});
+  s.point = V3::from(t.vec3_or("point", {0, 0, 0}));
+  if (t.has("axis") || shape != "stl") s.axis = read_unit_vector(t, "axis", {0, 0, 1});
   if (shape == "plane") s.shape = ToolShape::Plane;
   if (shape == "sphere" || shape == "cylinder" || shape == "torus" || shape == "plane_with_hole") {
     s.shape = shape == "sphere"     ? ToolShape::Sphere
@@ -58,11 +50,11 @@ void read_tool_motion(const TableReader& t, ToolMotion& m) {
   const std::string motion = t.choice("motion", {"fixed", "velocity", "force"}, "fixed");
   if (motion == "velocity") {
     m.kind = ToolMotion::Kind::Velocity;
-    m.velocity = to_v3(t.vec3("velocity"));
+    m.velocity = V3::from(t.vec3("velocity"));
     m.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
   } else if (motion == "force") {
     m.kind = ToolMotion::Kind::Force;
-    m.axis = unit_axis(t, "force_axis", {0, 0, -1});
+    m.axis = read_unit_vector(t, "force_axis", {0, 0, -1});
     if (t.has("force") && t.has("pressure"))
       t.fail("pressure", "give either force or pressure, not both");
     if (!t.has("pressure")) m.force = t.number("force", Range::non_negative());

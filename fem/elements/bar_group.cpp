@@ -85,13 +85,11 @@ std::unique_ptr<ElementGroup> make_bar2_group(const Model& model, const ElementS
 
 template <>
 BarBlock* block_of<BarBlock>(ElementGroup& g) {
-  auto* h = dynamic_cast<BarGroup*>(&g);
-  return h ? &h->block : nullptr;
+  return block_of_group<BarGroup>(g);
 }
 template <>
 const BarBlock* block_of<BarBlock>(const ElementGroup& g) {
-  const auto* h = dynamic_cast<const BarGroup*>(&g);
-  return h ? &h->block : nullptr;
+  return block_of_group<BarGroup>(g);
 }
 
 }  // namespace ncfsim::fem

@@ -11,4 +11,16 @@ Block* block_of(ElementGroup& g);
 template <class Block>
 const Block* block_of(const ElementGroup& g);
 
+/// The `block` of g when g is a `Group`, else null: what each kind's block_of specialisation is.
+template <class Group>
+auto* block_of_group(ElementGroup& g) {
+  auto* h = dynamic_cast<Group*>(&g);
+  return h ? &h->block : nullptr;
+}
+template <class Group>
+const auto* block_of_group(const ElementGroup& g) {
+  const auto* h = dynamic_cast<const Group*>(&g);
+  return h ? &h->block : nullptr;
+}
+
 }  // namespace ncfsim::fem

@@ -92,13 +92,11 @@ std::unique_ptr<ElementGroup> make_hex8_group(const Model& model, const ElementS
 
 template <>
 Hex8Block* block_of<Hex8Block>(ElementGroup& g) {
-  auto* h = dynamic_cast<Hex8Group*>(&g);
-  return h ? &h->block : nullptr;
+  return block_of_group<Hex8Group>(g);
 }
 template <>
 const Hex8Block* block_of<Hex8Block>(const ElementGroup& g) {
-  const auto* h = dynamic_cast<const Hex8Group*>(&g);
-  return h ? &h->block : nullptr;
+  return block_of_group<Hex8Group>(g);
 }
 
 }  // namespace ncfsim::fem

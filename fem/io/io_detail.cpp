@@ -44,10 +44,12 @@ void check_part_ids(const std::vector<std::int32_t>& parts, const char* what) {
 
 // An optional per-entity array of the stage hand-off: empty, or one value per entity.
 template <class T>
-void check_optional(const std::vector<T>& values, std::size_t n, const char* name, const char* what) {
+void check_optional(const std::vector<T>& values, std::size_t n, const char* name,
+                    const char* what) {
   if (!values.empty() && values.size() != n) {
-    throw std::invalid_argument(std::string("ResultMesh: ") + name + " has " + std::to_string(values.size()) +
-                                " entries for " + std::to_string(n) + " " + what);
+    throw std::invalid_argument(std::string("ResultMesh: ") + name + " has " +
+                                std::to_string(values.size()) + " entries for " +
+                                std::to_string(n) + " " + what);
   }
 }
 
@@ -210,47 +212,6 @@ void rename_replace(const std::filesystem::path& from, const std::filesystem::pa
   fsync_directory_of(to);
 }
 
-void atomic_write_text(const std::filesystem::path& path, std::string_view content) {
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw_errno("cannot create", tmp);
-  const char* p = content.data();
-  std::size_t left = content.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int err = errno;
-      ::close(fd);
-      std::remove(tmp.c_str());
-      errno = err;
-      throw_errno("cannot write", tmp);
-    }
-    p += n;
-    left -= static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    std::remove(tmp.c_str());
-    errno = err;
-    throw_errno("fsync failed for", tmp);
-  }
-  if (::close(fd) != 0) {
-    const int err = errno;
-    std::remove(tmp.c_str());
-    errno = err;
-    throw_errno("cannot close", tmp);
-  }
-  try {
-    rename_replace(tmp, path);
-  } catch (...) {
-    std::remove(tmp.c_str());
-    throw;
-  }
-}
-
 std::vector<double> current_coordinates(const ResultMesh& mesh, const Frame& frame) {
   std::vector<double> x(mesh.points.size());
   for (std::size_t i = 0; i < x.size(); ++i) x[i] = mesh.points[i] + frame.displacement[i];
@@ -274,4 +235,45 @@ bool is_reserved_field_name(std::string_view name) {
 }
 
 }  // namespace detail
+void atomic_write_text(const std::filesystem::path& path, std::string_view content) {
+  std::filesystem::path tmp = path;
+  tmp += ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) detail::throw_errno("cannot create", tmp);
+  const char* p = content.data();
+  std::size_t left = content.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      std::remove(tmp.c_str());
+      errno = err;
+      detail::throw_errno("cannot write", tmp);
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    std::remove(tmp.c_str());
+    errno = err;
+    detail::throw_errno("fsync failed for", tmp);
+  }
+  if (::close(fd) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    errno = err;
+    detail::throw_errno("cannot close", tmp);
+  }
+  try {
+    detail::rename_replace(tmp, path);
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
+  }
+}
+
 }  // namespace ncfsim::fem::io

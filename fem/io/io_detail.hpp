@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fem/io/atomic_file.hpp"
 #include "fem/io/result_writers.hpp"
 
 namespace ncfsim::fem::io::detail {
@@ -17,10 +18,7 @@ std::string zero_padded(std::size_t value, int width);
 /// Escapes & < > " ' for XML text and attribute values.
 std::string xml_escape(std::string_view text);
 
-/// Writes `content` to `path` so that a reader sees either the old or the new file: writes
-/// `path`.tmp, fsyncs it, renames it over `path`, fsyncs the directory (best effort).
-/// Throws std::runtime_error naming the file on failure.
-void atomic_write_text(const std::filesystem::path& path, std::string_view content);
+using io::atomic_write_text;  // fem/io/atomic_file.hpp
 /// fsync of an existing file (best effort for the directory). Throws std::runtime_error.
 void fsync_file(const std::filesystem::path& path);
 /// Renames `from` to `to` (replacing `to`) and fsyncs the directory. Throws std::runtime_error.

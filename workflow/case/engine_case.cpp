@@ -16,9 +16,7 @@ using fem::TableReader;
 
 void read_case_header(const TableReader& root, EngineCase& ec) {
   const TableReader c = root.required_table("case");
-  ec.name = c.string("name");
-  if (ec.name.empty() || ec.name.find_first_of("/\\ ") != std::string::npos)
-    c.fail("name", "must be a non-empty name without spaces or slashes (it names the output folder)");
+  ec.name = fem::read_case_name(c);
   ec.kind = c.choice("kind", {"engine"}, "engine");
   ec.description = c.string("description", "");
 }
@@ -26,11 +24,14 @@ void read_case_header(const TableReader& root, EngineCase& ec) {
 // [mesh]: fem's blocks and lines, drape's fabrics, then the renumbering both follow.
 std::vector<drape::FabricEntry> read_mesh(CaseReadContext& ctx) {
   if (!ctx.root.has("mesh"))
-    ctx.root.fail("mesh", "missing (required section [mesh] with [[mesh.block]] or [[mesh.line]] entries)");
+    ctx.root.fail("mesh",
+                  "missing (required section [mesh] with [[mesh.block]] or [[mesh.line]] entries)");
   const TableReader m = ctx.root.required_table("mesh");
   fem::read_mesh_blocks(ctx, m);
   if (m.tables("block").empty() && m.tables("line").empty() && !m.has("fabric"))
-    m.fail("block", "the mesh has no elements: give at least one [[mesh.block]], [[mesh.line]] or [[mesh.fabric]]");
+    m.fail("block",
+           "the mesh has no elements: give at least one [[mesh.block]], [[mesh.line]] or "
+           "[[mesh.fabric]]");
   auto fabrics = drape::read_fabrics(ctx, m);
   const auto new_of_old = fem::finish_mesh(ctx);
   drape::renumber_fabrics(ctx, fabrics, new_of_old);
@@ -73,7 +74,8 @@ void read_output(const CaseReadContext& ctx, EngineCase& ec) {
   ec.output.vtu = frames == "vtu" || frames == "both";
   ec.output.figures = o->boolean("figures", true);
   ec.output.report = o->boolean("report", false);
-  for (const auto& t : o->tables("probe")) ec.probes.push_back({t.string("name"), fem::select_nodes(ctx, t, "nodes")});
+  for (const auto& t : o->tables("probe"))
+    ec.probes.push_back({t.string("name"), fem::select_nodes(ctx, t, "nodes")});
   ec.shear_probes = drape::read_shear_probes(ctx, *o);
   ec.ring_probes = drape::read_ring_shear_probes(ctx, *o);
   for (const auto& t : o->tables("mean")) ec.means.push_back(read_mean(t));
@@ -105,7 +107,8 @@ PlotSpec read_plot(const TableReader& t) {
   p.x_label = t.string("x_label", p.x);
   p.y_label = t.string("y_label", p.y.empty() ? "" : p.y.front());
   for (const auto& it : t.tables("import")) p.imports.push_back(read_import(it));
-  for (const auto& rt : t.tables("reference")) p.references.push_back({rt.string("label"), rt.number("y", {})});
+  for (const auto& rt : t.tables("reference"))
+    p.references.push_back({rt.string("label"), rt.number("y", {})});
   return p;
 }
 
@@ -113,8 +116,8 @@ PictureSpec read_picture(const TableReader& t, const fem::Mesh& mesh) {
   PictureSpec p;
   p.name = t.string("name");
   p.field = t.choice("field",
-                     {"displacement_magnitude", "displacement", "velocity", "stress", "von_mises_stress",
-                      "fibre_direction", "axial_force", "axial_strain", "none"},
+                     {"displacement_magnitude", "displacement", "velocity", "stress",
+                      "von_mises_stress", "fibre_direction", "axial_force", "axial_strain", "none"},
                      "displacement_magnitude");
   p.component = static_cast<int>(t.integer("component", -1, -1, 5));
   p.camera = t.choice("camera", {"iso", "top", "front"}, "iso");
@@ -148,7 +151,8 @@ fem::CaseTypeRegistry engine_case_types() {
   return types;
 }
 
-EngineCase load_engine_case(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+EngineCase load_engine_case(const std::filesystem::path& file,
+                            const std::vector<std::string>& overrides) {
   fem::CaseDocument doc = fem::CaseDocument::load(file, overrides);
   const fem::CaseTypeRegistry types = engine_case_types();
   EngineCase ec;

@@ -1,27 +1,27 @@
 #include "workflow/output/output_files.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
+#include <fmt/format.h>
+#include <spdlog/sinks/basic_file_sink.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
 
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
-#include <fmt/format.h>
-#include <spdlog/sinks/basic_file_sink.h>
-#include <spdlog/sinks/stdout_color_sinks.h>
+#include "fem/io/atomic_file.hpp"
 
 namespace ncfsim::workflow {
 
 std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out_dir, Verbosity v) {
   auto console = std::make_shared<spdlog::sinks::stdout_color_sink_mt>();
   console->set_pattern("%v");
-  console->set_level(v == Verbosity::Quiet ? spdlog::level::warn
+  console->set_level(v == Verbosity::Quiet     ? spdlog::level::warn
                      : v == Verbosity::Verbose ? spdlog::level::debug
                                                : spdlog::level::info);
   std::vector<spdlog::sink_ptr> sinks{console};
   if (!out_dir.empty()) {
-    auto file = std::make_shared<spdlog::sinks::basic_file_sink_mt>((out_dir / "log.txt").string(), true);
+    auto file =
+        std::make_shared<spdlog::sinks::basic_file_sink_mt>((out_dir / "log.txt").string(), true);
     file->set_pattern("[%Y-%m-%d %H:%M:%S] %v");
     file->set_level(v == Verbosity::Verbose ? spdlog::level::debug : spdlog::level::info);
     sinks.push_back(file);
@@ -33,23 +33,7 @@ std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out
 }
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) throw std::runtime_error("cannot write " + tmp.string());
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t w = ::write(fd, text.data() + done, text.size() - done);
-    if (w <= 0) {
-      ::close(fd);
-      throw std::runtime_error("cannot write " + tmp.string());
-    }
-    done += static_cast<std::size_t>(w);
-  }
-  ::fsync(fd);
-  ::close(fd);
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + ec.message());
+  fem::io::atomic_write_text(path, text);
 }
 
 HistoryWriter::HistoryWriter(const std::filesystem::path& file, std::vector<std::string> columns)

@@ -3,14 +3,14 @@
 // back: log (console + log.txt), atomic replacement (summary.json, figures.json, report.html),
 // history.csv and other numeric CSV. Shared by workflow/run, figures, report and calibrate, and
 // includes none of them (dependencies point one way: run -> figures/report -> output).
+#include <spdlog/logger.h>
+
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
-#include <spdlog/logger.h>
 
 namespace ncfsim::workflow {
 
@@ -19,8 +19,8 @@ enum class Verbosity { Quiet, Normal, Verbose };
 /// Console + log.txt logger; the same lines go to both (the console honours the verbosity).
 std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out_dir, Verbosity v);
 
-/// Writes text to `path` through a temporary file in the same folder, fsync and rename, so that a
-/// reader sees either the old or the new complete file.
+/// Writes text to `path` so that a reader sees either the old or the new complete file
+/// (fem/io/atomic_file.hpp).
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 
 /// history.csv: a header with named columns (units in the names), then one row per output time.

@@ -253,8 +253,8 @@ void draw_figures_and_report(const Run& r) {
 
 }  // namespace
 
-std::filesystem::path output_folder(const EngineCase& ec, const RunOptions& o) {
-  return o.out_dir.empty() ? std::filesystem::path("results") / ec.name : o.out_dir;
+std::filesystem::path output_folder(const std::string& case_name, const RunOptions& o) {
+  return o.out_dir.empty() ? std::filesystem::path("results") / case_name : o.out_dir;
 }
 
 int run_engine_case(EngineCase& ec, const RunOptions& options) {

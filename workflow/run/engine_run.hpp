@@ -24,7 +24,10 @@ enum ExitCode : int { kSuccess = 0, kOtherError = 1, kBadInput = 2, kNumericalFa
 /// Runs the case; returns the exit code. Bad input found before the run throws InputError.
 int run_engine_case(EngineCase& ec, const RunOptions& options);
 
-/// The folder a run writes to: options.out_dir, or results/<case name>.
-std::filesystem::path output_folder(const EngineCase& ec, const RunOptions& options);
+/// The folder a run (of any stage) writes to: options.out_dir, or results/<case name>.
+std::filesystem::path output_folder(const std::string& case_name, const RunOptions& options);
+inline std::filesystem::path output_folder(const EngineCase& ec, const RunOptions& options) {
+  return output_folder(ec.name, options);
+}
 
 }  // namespace ncfsim::workflow

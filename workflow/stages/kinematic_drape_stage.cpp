@@ -17,15 +17,6 @@ namespace ncfsim::workflow {
 
 namespace {
 
-std::string ring_csv(const std::vector<drape::RingSample>& ring) {
-  std::string s = "azimuth_deg,kinematic_shear_deg,hit,x_m,y_m,z_m\n";
-  for (const auto& r : ring)
-    s += fmt::format("{:.6g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.azimuth_deg,
-                     r.hit ? r.shear_deg : std::nan(""), r.hit ? 1 : 0, r.point.x, r.point.y,
-                     r.point.z);
-  return s;
-}
-
 std::string net_csv(const drape::KinematicNet& net) {
   std::string s = "i,j,x_m,y_m,z_m,shear_deg\n";
   for (int j = -net.n; j <= net.n; ++j)
@@ -43,9 +34,7 @@ std::string net_csv(const drape::KinematicNet& net) {
 int run_kinematic_drape_stage(const StageCall& call) {
   const auto kc = drape::load_kinematic_drape_case(call.case_file, call.overrides);
   const auto t0 = std::chrono::steady_clock::now();
-  const std::filesystem::path dir = call.options.out_dir.empty()
-                                        ? std::filesystem::path("results") / kc.name
-                                        : call.options.out_dir;
+  const std::filesystem::path dir = output_folder(kc.name, call.options);
   std::filesystem::create_directories(dir);
   auto log = make_run_logger(dir, call.options.verbosity);
   log->info("ncfsim {} | case '{}' ({}) | kinematic drape", kVersion, kc.name,
@@ -72,7 +61,7 @@ int run_kinematic_drape_stage(const StageCall& call) {
             kc.ring.height, q.max_shear_deg[0], q.max_shear_deg[1], q.max_shear_deg[2],
             q.max_shear_deg[3]);
 
-  write_file_atomically(dir / "ring_shear.csv", ring_csv(ring));
+  write_file_atomically(dir / "ring_shear.csv", drape::ring_csv(ring, "kinematic_shear_deg"));
   write_file_atomically(dir / "net.csv", net_csv(net));
   nlohmann::json s;
   s["case"] = kc.name;
