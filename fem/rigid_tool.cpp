@@ -196,52 +196,117 @@ V3 tool_prescribed_velocity(const RigidTool& tool, double t) {
   return smooth_ramp(t, tool.motion.ramp_time) * tool.motion.velocity;
 }
 
+namespace {
+
+// Penalty force of the tool on contact node s (index into contact_nodes) at gap < thickness:
+// added to fc, its reaction to ftool; returns false (and clears the friction spring) when apart.
+inline bool tool_node_force(RigidTool& tool, std::size_t s, const double* x, const double* v,
+                            const double* mass, double dt, double inv_dt2, double* fc, V3& ftool) {
+  const auto i = static_cast<std::size_t>(tool.contact_nodes[s]);
+  const V3 p = V3::at(x + 3 * i) - tool.displacement;
+  double gap = 0;
+  V3 nrm;
+  V3* ft = reinterpret_cast<V3*>(&tool.tangential[3 * s]);
+  if (!tool.surface.gap_at(p, gap, nrm) || gap - tool.thickness >= 0) {
+    *ft = {};
+    return false;
+  }
+  const double m = mass[3 * i];
+  const double k = tool.penalty_scale * m * inv_dt2;
+  const double fn = -k * (gap - tool.thickness);
+  const V3 vrel = V3::at(v + 3 * i) - tool.velocity;
+  const double vn = dot(vrel, nrm);  // > 0: separating
+  // c = 2 zeta sqrt(k m) = 2 zeta m sqrt(penalty_scale) / dt
+  const double c = 2.0 * tool.damping * m * std::sqrt(tool.penalty_scale) / dt;
+  const double f_normal = std::max(fn - c * vn, 0.0);
+  tool.friction_dissipation += (fn - f_normal) * vn * dt;
+  V3 F = f_normal * nrm;
+  if (tool.friction > 0) {
+    const V3 vt = vrel - vn * nrm;
+    V3 trial = *ft - dot(*ft, nrm) * nrm;
+    trial -= (k * dt) * vt;
+    const double cap = tool.friction * fn, mag = norm(trial);
+    if (mag > cap) {
+      tool.friction_dissipation += cap * (mag - cap) / k;
+      trial = (cap / mag) * trial;
+    }
+    *ft = trial;
+    F += trial;
+  } else {
+    *ft = {};
+  }
+  fc[3 * i] += F.x;
+  fc[3 * i + 1] += F.y;
+  fc[3 * i + 2] += F.z;
+  ftool -= F;
+  return true;
+}
+
+double automatic_margin(const RigidTool& tool, const double* x) {
+  V3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (auto node : tool.contact_nodes) {
+    const V3 p = V3::at(x + 3 * static_cast<std::size_t>(node));
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  return std::max(0.01 * norm(hi - lo), 4.0 * tool.thickness);
+}
+
+}  // namespace
+
+double RigidSurface::reach_distance(const V3& p, double offset) const {
+  double gap = 0;
+  V3 nrm;
+  if (gap_at(p, gap, nrm)) return gap - offset;
+  switch (shape) {
+    case ToolShape::PlaneWithHole: {  // in the hole: it must reach the hole's rim first
+      const V3 r = p - point;
+      const V3 radial = r - dot(r, axis) * axis;
+      return radius - norm(radial);
+    }
+    case ToolShape::Triangles:  // nothing within search_radius
+      return search_radius - offset;
+    default:  // on a sphere's centre or a torus's axis: no bound
+      return 0.0;
+  }
+}
+
 void tool_contact_forces(RigidTool& tool, const double* x, const double* v, const double* mass,
                          double dt, double* fc) {
   const std::size_t n = tool.contact_nodes.size();
   if (tool.tangential.size() != 3 * n) tool.tangential.assign(3 * n, 0.0);
   const double inv_dt2 = 1.0 / (dt * dt);
+  ToolProximity& near = tool.proximity;
+  if (near.valid) {  // can a node outside the near list have closed the margin since?
+    double d2 = 0;
+    const double* xr = near.x_ref.data();
+    for (std::size_t s = 0; s < n; ++s) {
+      const double* p = x + 3 * static_cast<std::size_t>(tool.contact_nodes[s]);
+      const double dx = p[0] - xr[3 * s], dy = p[1] - xr[3 * s + 1], dz = p[2] - xr[3 * s + 2];
+      d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
+    }
+    near.valid = std::sqrt(d2) + norm(tool.displacement - near.tool_ref) < near.margin;
+  }
   V3 ftool{};
   std::int64_t active = 0;
-  for (std::size_t s = 0; s < n; ++s) {
-    const auto i = static_cast<std::size_t>(tool.contact_nodes[s]);
-    const V3 p = V3::at(x + 3 * i) - tool.displacement;
-    double gap = 0;
-    V3 nrm;
-    V3* ft = reinterpret_cast<V3*>(&tool.tangential[3 * s]);
-    if (!tool.surface.gap_at(p, gap, nrm) || gap - tool.thickness >= 0) {
-      *ft = {};
-      continue;
+  if (near.valid) {
+    for (const auto s : near.near)
+      active += tool_node_force(tool, static_cast<std::size_t>(s), x, v, mass, dt, inv_dt2, fc, ftool);
+  } else {  // rebuild: every contact node, and the near list for the cycles that follow
+    if (near.margin <= 0) near.margin = tool.search_margin > 0 ? tool.search_margin : automatic_margin(tool, x);
+    near.near.clear();
+    near.x_ref.resize(3 * n);
+    for (std::size_t s = 0; s < n; ++s) {
+      active += tool_node_force(tool, s, x, v, mass, dt, inv_dt2, fc, ftool);
+      const auto i = static_cast<std::size_t>(tool.contact_nodes[s]);
+      const V3 p = V3::at(x + 3 * i);
+      std::copy(x + 3 * i, x + 3 * i + 3, near.x_ref.data() + 3 * s);
+      if (tool.surface.reach_distance(p - tool.displacement, tool.thickness) < near.margin)
+        near.near.push_back(static_cast<std::int32_t>(s));
     }
-    ++active;
-    const double m = mass[3 * i];
-    const double k = tool.penalty_scale * m * inv_dt2;
-    const double fn = -k * (gap - tool.thickness);
-    const V3 vrel = V3::at(v + 3 * i) - tool.velocity;
-    const double vn = dot(vrel, nrm);  // > 0: separating
-    // c = 2 zeta sqrt(k m) = 2 zeta m sqrt(penalty_scale) / dt
-    const double c = 2.0 * tool.damping * m * std::sqrt(tool.penalty_scale) / dt;
-    const double f_normal = std::max(fn - c * vn, 0.0);
-    tool.friction_dissipation += (fn - f_normal) * vn * dt;
-    V3 F = f_normal * nrm;
-    if (tool.friction > 0) {
-      const V3 vt = vrel - vn * nrm;
-      V3 trial = *ft - dot(*ft, nrm) * nrm;
-      trial -= (k * dt) * vt;
-      const double cap = tool.friction * fn, mag = norm(trial);
-      if (mag > cap) {
-        tool.friction_dissipation += cap * (mag - cap) / k;
-        trial = (cap / mag) * trial;
-      }
-      *ft = trial;
-      F += trial;
-    } else {
-      *ft = {};
-    }
-    fc[3 * i] += F.x;
-    fc[3 * i + 1] += F.y;
-    fc[3 * i + 2] += F.z;
-    ftool -= F;
+    near.tool_ref = tool.displacement;
+    near.valid = true;
+    ++near.n_rebuilds;
   }
   tool.force = ftool;
   tool.n_active = active;

@@ -46,6 +46,21 @@ struct RigidSurface {
 
   /// Gap (positive = apart) and outward unit normal at a point in the tool's own frame.
   bool gap_at(const V3& p, double& gap, V3& normal) const;
+  /// A lower bound on how far p (tool frame) must move before gap_at can report gap < offset:
+  /// the proximity cull skips nodes that cannot reach the tool before the next rebuild.
+  double reach_distance(const V3& p, double offset) const;
+};
+
+/// Which of a tool's contact nodes can touch it soon: the nodes within `margin` of the tool at
+/// the last rebuild. Rebuilt (a full pass over the contact nodes) once the largest node
+/// displacement plus the tool's own since then could close the margin, so no contact is missed.
+struct ToolProximity {
+  double margin = 0;                 // m; 0 until the first rebuild sets it
+  std::vector<std::int32_t> near;    // indices into RigidTool::contact_nodes
+  std::vector<double> x_ref;         // [3*n_contact_nodes] positions at the last rebuild
+  V3 tool_ref;                       // tool displacement at the last rebuild
+  std::int64_t n_rebuilds = 0;
+  bool valid = false;
 };
 
 struct ToolMotion {
@@ -72,6 +87,9 @@ struct RigidTool {
   /// Its work is reported with the friction dissipation.
   double damping = 0.1;
   double thickness = 0;       // contact offset (shell thickness / 2 or clearance)
+  /// Proximity cull margin, m; 0: automatic (1 % of the contact nodes' bounding-box diagonal,
+  /// at least 4 x thickness). Larger: fewer rebuilds, more nodes tested per cycle.
+  double search_margin = 0;
 
   // State
   V3 displacement;                  // tool translation at the current time
@@ -80,6 +98,7 @@ struct RigidTool {
   std::vector<double> tangential;   // [3*n_contact_nodes] elastic friction forces
   double friction_dissipation = 0;  // J, friction and normal damping
   std::int64_t n_active = 0;
+  ToolProximity proximity;
 };
 
 /// Smooth ramp from 0 to 1 over [0, t_ramp] (cubic, zero slope at both ends).

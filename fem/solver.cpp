@@ -165,6 +165,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
       if (node < 0 || static_cast<std::size_t>(node) >= n)
         throw InputError("", "tool." + tool.name, "contact node outside the mesh");
     tool.tangential.assign(3 * tool.contact_nodes.size(), 0.0);
+    tool.proximity = ToolProximity{};
     tool.displacement = {};
     tool.velocity = tool_prescribed_velocity(tool, 0.5 * dt_);
   }

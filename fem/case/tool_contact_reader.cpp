@@ -99,6 +99,7 @@ void read_tool(CaseReadContext& ctx, const TableReader& t) {
   tool.penalty_scale = t.number("penalty_scale", 0.1, Range::open_closed(0, 1.0));
   tool.damping = t.number("damping", 0.1, Range::closed(0, 1.0));
   tool.thickness = t.number("thickness", 0.0, Range::non_negative());
+  tool.search_margin = t.number("search_margin", 0.0, Range::non_negative());
   tool.contact_nodes = select_nodes(ctx, t, "contact_nodes");
   if (tool.motion.kind == ToolMotion::Kind::Force && t.has("pressure")) {
     if (tool.surface.shape != ToolShape::Plane && tool.surface.shape != ToolShape::PlaneWithHole)
