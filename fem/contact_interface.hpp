@@ -45,6 +45,8 @@ class ContactAlgorithm {
   virtual double stable_step_limit() const { return 1e300; }
   /// Number of active contacts after the last add_forces (diagnostics).
   virtual std::int64_t active_contacts() const { return 0; }
+  /// Deepest penetration past the contact thickness over the run so far, m (0: not tracked).
+  virtual double max_penetration() const { return 0; }
   /// The elements `mesh_elements` (mesh-wide indices: Mesh::element_offset of the kind plus the
   /// index in its set) were eroded: their faces stop being contact segments from the next
   /// add_forces on, and the faces of their neighbours that they covered start being ones.

@@ -64,6 +64,10 @@ struct TimeControl {
   double frame_interval = 0;        // 0: 20 frames over the run
   std::int64_t max_cycles = 0;      // 0: unlimited
   double energy_balance_limit = 0.05;
+  // Quasi-static check: kinetic / internal energy is tracked from this time on (s; forming runs
+  // read it after the blankholder has closed) and warned about above the limit (0: never).
+  double quasi_static_from = 0;
+  double kinetic_to_internal_limit = 0;
   double min_step_ratio = 1e-4;     // stop when the step falls below this share of the initial one
   double erosion_step_ratio = 0;    // 0: off; else erode an element (hexahedra) whose step falls below this
                                     // share of the initial one (LS-DYNA's ERODE with DTMIN)

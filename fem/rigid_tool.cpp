@@ -214,6 +214,7 @@ inline bool tool_node_force(RigidTool& tool, std::size_t s, const double* x, con
   const double m = mass[3 * i];
   const double k = tool.penalty_scale * m * inv_dt2;
   const double fn = -k * (gap - tool.thickness);
+  tool.max_penetration = std::max(tool.max_penetration, tool.thickness - gap);
   const V3 vrel = V3::at(v + 3 * i) - tool.velocity;
   const double vn = dot(vrel, nrm);  // > 0: separating
   // c = 2 zeta sqrt(k m) = 2 zeta m sqrt(penalty_scale) / dt

@@ -98,6 +98,7 @@ struct RigidTool {
   std::vector<double> tangential;   // [3*n_contact_nodes] elastic friction forces
   double friction_dissipation = 0;  // J, friction and normal damping
   std::int64_t n_active = 0;
+  double max_penetration = 0;       // deepest node past the contact offset over the run, m
   ToolProximity proximity;
 };
 

@@ -69,7 +69,14 @@ FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution
 }
 
 void read_stitch_laws(const TableReader& fb, const FabricSpec& f, FabricEntry& fe) {
-  if (f.stitch == StitchPattern::None) return;
+  if (f.stitch == StitchPattern::None) {
+    // A blank without stitch may keep its stitch keys (a control case made from a stitched one
+    // by stitch = "none" alone): they are read and have no effect.
+    for (const char* k : {"stitch_law_I", "stitch_law_Lambda", "stitch_law_legs"}) (void)fb.string(k, "");
+    for (const char* k : {"connection_sliding_force", "connection_transverse_force", "connection_stiffness"})
+      (void)fb.number(k, 0.0, {});
+    return;
+  }
   fe.law_I = fb.string("stitch_law_I");
   fe.law_Lambda = f.stitch == StitchPattern::Tricot ? fb.string("stitch_law_Lambda") : fe.law_I;
   fe.law_legs = fb.string("stitch_law_legs", fe.law_I);

@@ -96,24 +96,84 @@ toml::table* ensure_table(toml::table& root, const std::vector<std::string>& par
 
 }  // namespace
 
-CaseDocument CaseDocument::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-  CaseDocument doc;
-  doc.file_ = file;
+namespace {
+
+toml::table parse_case_file(const std::filesystem::path& file) {
   const std::string fname = file.string();
   if (!std::filesystem::exists(file)) throw InputError(fname, "", "no such case file");
+  if (std::filesystem::is_directory(file)) throw InputError(fname, "", "is a folder, not a case file");
   try {
-    doc.root_ = toml::parse_file(fname);
+    return toml::parse_file(fname);
   } catch (const toml::parse_error& e) {
     std::ostringstream os;
     os << "TOML syntax error at line " << e.source().begin.line << ", column " << e.source().begin.column
        << ": " << e.description();
     throw InputError(fname, "", os.str());
   }
+}
+
+// A variant of another case ([case] base = "other.toml", set = ["key=value", ...]): the base
+// case with the variant's changes, named and described by the variant. It holds only [case], so
+// that each of its changes is one visible line and the base stays the one description of the rest.
+toml::table resolve_base(const std::filesystem::path& file, toml::table root, int depth) {
+  const std::string fname = file.string();
+  const toml::table* c = root["case"].as_table();
+  if (!c || !c->contains("base")) return root;
+  const auto base = (*c)["base"].value<std::string>();
+  if (!base || base->empty()) throw InputError(fname, "case.base", "must be the path of a case file");
+  if (depth >= 4) throw InputError(fname, "case.base", "bases nest more than 4 deep (a cycle?)");
+  for (const auto& [k, v] : root)
+    if (k.str() != "case")
+      throw InputError(fname, std::string(k.str()),
+                       "a case with case.base holds only [case]: give its changes in case.set "
+                       "(e.g. set = [\"mesh.fabric[0].stitch = 'none'\"])");
+  std::vector<std::string> sets;
+  if (c->contains("set")) {
+    const toml::array* a = (*c)["set"].as_array();
+    if (!a) throw InputError(fname, "case.set", "must be an array of \"key=value\" strings");
+    for (const auto& e : *a) {
+      const auto s = e.value<std::string>();
+      if (!s) throw InputError(fname, "case.set", "must be an array of \"key=value\" strings");
+      sets.push_back(*s);
+    }
+  }
+  std::filesystem::path base_file = *base;
+  if (base_file.is_relative()) base_file = file.parent_path() / base_file;
+  if (!std::filesystem::is_regular_file(base_file))
+    throw InputError(fname, "case.base", "no such case file: " + base_file.string());
+  CaseDocument b = CaseDocument::load_resolved(base_file, sets, depth + 1);
+  toml::table out = b.root();
+  toml::table* oc = out["case"].as_table();
+  if (!oc) {
+    out.insert("case", toml::table{});
+    oc = out["case"].as_table();
+  }
+  for (const auto& [k, v] : *c)
+    if (k.str() != "base" && k.str() != "set") oc->insert_or_assign(k.str(), v);
+  return out;
+}
+
+}  // namespace
+
+CaseDocument CaseDocument::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  return load_resolved(file, overrides, 0);
+}
+
+CaseDocument CaseDocument::load_resolved(const std::filesystem::path& file,
+                                         const std::vector<std::string>& overrides, int depth) {
+  CaseDocument doc;
+  doc.file_ = file;
+  const std::string fname = file.string();
+  doc.root_ = resolve_base(file, parse_case_file(file), depth);
   for (const std::string& ov : overrides) {
     const auto eq = ov.find('=');
     if (eq == std::string::npos || eq == 0)
       throw InputError(fname, ov, "--set needs KEY=VALUE (e.g. --set mesh.resolution=coarse)");
-    const std::string key = ov.substr(0, eq), value = ov.substr(eq + 1);
+    auto trim = [](std::string s) {
+      const auto a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
+      return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+    };
+    const std::string key = trim(ov.substr(0, eq)), value = trim(ov.substr(eq + 1));
     std::vector<std::string> parts;
     std::stringstream ss(key);
     for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);

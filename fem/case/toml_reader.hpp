@@ -23,7 +23,11 @@ namespace ncfsim::fem {
 class CaseDocument {
  public:
   /// Parses the file; applies `overrides` ("a.b.c=value", value in TOML syntax or a bare string).
+  /// A case with `[case] base = "other.toml"` is that case with the changes of its `case.set`
+  /// list applied first (as --set), then its own [case] keys (name, description).
   static CaseDocument load(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+  static CaseDocument load_resolved(const std::filesystem::path& file,
+                                    const std::vector<std::string>& overrides, int depth);
   const std::filesystem::path& file() const { return file_; }
   const toml::table& root() const { return root_; }
   void mark_read(const std::string& path) { read_.insert(path); }

@@ -1,5 +1,6 @@
 // [[tool]] (rigid tools) and [[contact]] (deformable contacts).
 #include <map>
+#include <sstream>
 #include <stdexcept>
 
 #include "fem/case/fem_case.hpp"
@@ -90,6 +91,30 @@ double covered_area(const TableReader& t, const RigidTool& tool, const Mesh& mes
   return area;
 }
 
+// A tool must start clear of its contact nodes: a node inside it would be thrown out by the
+// penalty spring at the first cycle (k = scale m / dt^2 times the depth).
+void check_starts_clear(const TableReader& t, const RigidTool& tool, const Mesh& mesh) {
+  double deepest = 0;
+  std::int32_t worst = -1;
+  for (auto node : tool.contact_nodes) {
+    const auto p = mesh.node(static_cast<std::size_t>(node));
+    double gap = 0;
+    V3 nrm;
+    if (!tool.surface.gap_at(V3{p[0], p[1], p[2]}, gap, nrm)) continue;
+    const double depth = tool.thickness - gap;
+    if (depth > deepest) deepest = depth, worst = node;
+  }
+  // Round-off of nodes laid on the surface is allowed; a thousandth of a millimetre is not that.
+  if (worst < 0 || deepest <= 1e-6) return;
+  const auto p = mesh.node(static_cast<std::size_t>(worst));
+  std::ostringstream os;
+  os << "tool '" << tool.name << "' starts inside the body it contacts: node "
+     << mesh.node_user_id[static_cast<std::size_t>(worst)] << " at (" << p[0] << ", " << p[1] << ", "
+     << p[2] << ") m is " << deepest * 1e3
+     << " mm inside it; place the tool (point, radius) clear of its contact nodes";
+  t.fail("point", os.str());
+}
+
 void read_tool(CaseReadContext& ctx, const TableReader& t) {
   RigidTool tool;
   tool.name = t.string("name");
@@ -101,6 +126,7 @@ void read_tool(CaseReadContext& ctx, const TableReader& t) {
   tool.thickness = t.number("thickness", 0.0, Range::non_negative());
   tool.search_margin = t.number("search_margin", 0.0, Range::non_negative());
   tool.contact_nodes = select_nodes(ctx, t, "contact_nodes");
+  check_starts_clear(t, tool, ctx.model.mesh);
   if (tool.motion.kind == ToolMotion::Kind::Force && t.has("pressure")) {
     if (tool.surface.shape != ToolShape::Plane && tool.surface.shape != ToolShape::PlaneWithHole)
       t.fail("pressure", "only a plane or plane_with_hole tool presses with a pressure");

@@ -547,6 +547,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   dissipation_ += dissipated;
   stats_.n_active = n_active;
   stats_.max_penetration = max_pen;
+  stats_.run_max_penetration = std::max(stats_.run_max_penetration, max_pen);
   stats_.max_penetration_node = max_pen_node;
   stats_.narrow_seconds += seconds(t1, Clock::now());
 }

@@ -58,6 +58,7 @@ struct PenaltyContactStats {
   std::int64_t n_candidates = 0;           // node-segment candidates after the last sort
   std::int64_t n_active = 0;               // contacts in the last cycle
   double max_penetration = 0;              // largest (thickness - gap) in the last cycle, m
+  double run_max_penetration = 0;          // ... over every cycle so far, m
   std::int32_t max_penetration_node = -1;  // mesh node where it occurs
   double sort_seconds = 0;                 // time in bucket sorts (broad phase)
   double check_seconds = 0;                // time in the displacement checks
@@ -78,6 +79,7 @@ class PenaltyContact final : public ContactAlgorithm {
   double friction_dissipation() const override { return dissipation_; }
   std::vector<ContactResultant> resultants() const override;
   std::int64_t active_contacts() const override { return stats_.n_active; }
+  double max_penetration() const override { return stats_.run_max_penetration; }
   /// Faces of eroded hexahedra leave the surface; the faces of their neighbours in the same group
   /// that they covered join it (set up when the solver erodes: ContactSetup::erosion).
   void erode(const std::vector<std::int32_t>& mesh_elements) override;

@@ -186,7 +186,7 @@ TEST(CaseReading, BlankholderPressureGivesTheForceOverTheCoveredArea) {
   const auto ec = workflow::load_engine_case(file, ci);
   const auto& bh = ec.model.tools.at(1);
   ASSERT_EQ(bh.name, "blankholder");
-  const double area = 0.24 * 0.24 - M_PI * 0.099 * 0.099;
+  const double area = 0.24 * 0.24 - M_PI * 0.090 * 0.090;  // the 90 mm blankholder hole
   EXPECT_NEAR(bh.motion.pressed_area, area, 1e-9 * area);
   EXPECT_NEAR(bh.motion.force, 3350.0 * area, 1e-9 * 3350.0 * area);
   auto expect_key = [&](std::vector<std::string> extra, const std::string& key) {
@@ -203,4 +203,37 @@ TEST(CaseReading, BlankholderPressureGivesTheForceOverTheCoveredArea) {
   expect_key({"tool[1].force=10.0"}, "tool[1].pressure");  // both given
   expect_key({"mesh.fabric[0].size=[0.15,0.15]", "mesh.fabric[0].origin=[-0.075,-0.075,0.0]"},
              "tool[1].radius");
+}
+
+// A variant case ([case] base, set): the base with the listed changes and the variant's name; a
+// variant with tables of its own, a set entry without '=', a missing base: bad input naming the key.
+TEST(CaseReading, VariantCaseIsItsBaseWithItsChanges) {
+  write_case("variant_base", "[case]\nname = \"base\"\ndescription = \"the base\"\n[mesh]\nresolution = \"default\"\n"
+                             "[time]\nend_time = 0.01\nsafety_factor = 0.9\n");
+  const fs::path variant = write_case(
+      "variant", "[case]\nbase = \"variant_base.toml\"\nname = \"variant\"\n"
+                 "set = [\"time.end_time = 0.02\", \"mesh.resolution='coarse'\"]\n");
+  const auto doc = fem::CaseDocument::load(variant, {"time.safety_factor=0.5"});
+  const auto& root = doc.root();
+  EXPECT_EQ(root["case"]["name"].value<std::string>(), "variant");
+  EXPECT_EQ(root["case"]["description"].value<std::string>(), "the base");
+  EXPECT_FALSE(root["case"]["base"]);
+  EXPECT_DOUBLE_EQ(root["time"]["end_time"].value<double>().value(), 0.02);
+  EXPECT_DOUBLE_EQ(root["time"]["safety_factor"].value<double>().value(), 0.5);  // the command line last
+  EXPECT_EQ(root["mesh"]["resolution"].value<std::string>(), "coarse");
+
+  auto key_of_error = [](const fs::path& f) -> std::string {
+    try {
+      (void)fem::CaseDocument::load(f, {});
+    } catch (const InputError& e) {
+      return e.key();
+    }
+    return "(no error)";
+  };
+  EXPECT_EQ(key_of_error(write_case("variant_table", "[case]\nbase = \"variant_base.toml\"\n[time]\nend_time = 1.0\n")),
+            "time");
+  EXPECT_EQ(key_of_error(write_case("variant_noeq", "[case]\nbase = \"variant_base.toml\"\nset = [\"time.end_time\"]\n")),
+            "time.end_time");
+  EXPECT_EQ(key_of_error(write_case("variant_missing", "[case]\nbase = \"nowhere.toml\"\n")), "case.base");
+  EXPECT_EQ(key_of_error(write_case("variant_loop", "[case]\nbase = \"variant_loop.toml\"\n")), "case.base");
 }

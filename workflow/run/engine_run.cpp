@@ -91,6 +91,8 @@ struct Run {
   json summary;
   std::string status = "completed", failure;
   double max_error = 0;  // energy balance error over the run after its first 5 %
+  double ke_ie_max = 0;  // kinetic / internal energy at the history rows from time.quasi_static_from
+  bool ke_ie_exceeded = false;
 
   void write_summary() const { write_file_atomically(dir / "summary.json", summary.dump(2) + "\n"); }
 };
@@ -123,6 +125,11 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
   r.summary["frames"] = frames.written();
   r.summary["frame_write_errors"] = frames.errors();
   add_state_summary(s, r.max_error, r.summary);
+  r.summary["kinetic_to_internal_from_s"] = r.ec.model.time.quasi_static_from;
+  r.summary["kinetic_to_internal_max"] = r.ke_ie_max;
+  r.summary["kinetic_to_internal_end"] =
+      s.energy().internal > 0 ? s.energy().kinetic / s.energy().internal : 0.0;
+  r.summary["kinetic_to_internal_exceeded"] = r.ke_ie_exceeded;
   for (const auto& m : measures) m->add_summary(s, r.summary);
   add_history_summary(r.ec, history, r.summary);
   if (!r.failure.empty()) r.summary["error"] = r.failure;
@@ -184,6 +191,16 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
         if (t >= next_history) {
           history.write_row(solver);
           next_history += tc.history_interval;
+          const auto& en = solver.energy();
+          if (t >= tc.quasi_static_from && en.internal > 0) {
+            const double ratio = en.kinetic / en.internal;
+            r.ke_ie_max = std::max(r.ke_ie_max, ratio);
+            if (tc.kinetic_to_internal_limit > 0 && ratio > tc.kinetic_to_internal_limit && !r.ke_ie_exceeded) {
+              r.log->warn("kinetic / internal energy {:.3g} passed time.kinetic_to_internal_limit {:.3g} at t = {:.6g} s: "
+                          "not quasi-static (slower tool, less mass scaling)", ratio, tc.kinetic_to_internal_limit, t);
+              r.ke_ie_exceeded = true;
+            }
+          }
           if (!exceeded_reported && err > tc.energy_balance_limit && t > 0.05 * tc.end_time) {
             r.log->warn("energy balance error {:.3g} % passed its limit {:.3g} % at t = {:.6g} s", 100 * err,
                         100 * tc.energy_balance_limit, t);

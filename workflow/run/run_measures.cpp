@@ -78,6 +78,7 @@ class ToolMeasure final : public fem::RunMeasure {
   void add_summary(const fem::ExplicitSolver&, nlohmann::json& summary) const override {
     summary[tool_.name + "_force_N"] = -dot(tool_.force, tool_axis(tool_));
     summary[tool_.name + "_displacement_m"] = dot(tool_.displacement, tool_axis(tool_));
+    summary[tool_.name + "_max_penetration_m"] = tool_.max_penetration;  // over the run
   }
 
  private:
@@ -125,6 +126,12 @@ class ContactResultants final : public fem::RunMeasure {
     for (const auto& contact : s.model().contacts)
       for (const auto& r : contact->resultants())
         for (double v : r.force.arr()) row.push_back(v);
+  }
+  // Deepest penetration past the contact thickness over the run: a body passing through another
+  // shows as a depth near its thickness.
+  void add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const override {
+    for (const auto& contact : s.model().contacts)
+      summary[contact->name() + "_max_penetration_m"] = contact->max_penetration();
   }
 };
 
