@@ -12,13 +12,11 @@ namespace ncfsim::drape {
 
 using fem::V3;
 
-void interply_shear_deg(const std::vector<V3>& centroid, const std::vector<V3>& fibre,
-                        const std::vector<std::int32_t>& ply_a,
-                        const std::vector<std::int32_t>& ply_b, double reach,
-                        std::vector<double>& shear_deg) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
+void nearest_in_other_ply(const std::vector<V3>& centroid, const std::vector<std::int32_t>& ply_a,
+                          const std::vector<std::int32_t>& ply_b, double reach,
+                          std::vector<std::int32_t>& nearest) {
   if (ply_b.empty()) {
-    for (auto e : ply_a) shear_deg[static_cast<std::size_t>(e)] = nan;
+    for (auto e : ply_a) nearest[static_cast<std::size_t>(e)] = -1;
     return;
   }
   // Boxes of the other ply's centroids grown by the reach: a query point finds every element of
@@ -38,7 +36,7 @@ void interply_shear_deg(const std::vector<V3>& centroid, const std::vector<V3>& 
     const double q[3] = {p.x, p.y, p.z};
     std::int32_t begin = 0, end = 0;
     double best = reach * reach;
-    std::int32_t nearest = -1;
+    std::int32_t found = -1;
     if (grid.cell_of(q, begin, end))
       for (std::int32_t it = begin; it < end; ++it) {
         const std::int32_t k = grid.items()[it];
@@ -46,13 +44,24 @@ void interply_shear_deg(const std::vector<V3>& centroid, const std::vector<V3>& 
         const double d2 = dot(d, d);
         if (d2 <= best) {
           best = d2;
-          nearest = ply_b[static_cast<std::size_t>(k)];
+          found = ply_b[static_cast<std::size_t>(k)];
         }
       }
+    nearest[static_cast<std::size_t>(e)] = found;
+  }
+}
+
+void interply_shear_deg(const std::vector<V3>& centroid, const std::vector<V3>& fibre,
+                        const std::vector<std::int32_t>& ply_a,
+                        const std::vector<std::int32_t>& ply_b, double reach,
+                        std::vector<double>& shear_deg) {
+  std::vector<std::int32_t> nearest(centroid.size(), -1);
+  nearest_in_other_ply(centroid, ply_a, ply_b, reach, nearest);
+  for (auto e : ply_a) {
+    const std::int32_t j = nearest[static_cast<std::size_t>(e)];
     shear_deg[static_cast<std::size_t>(e)] =
-        nearest < 0 ? nan
-                    : shear_angle_deg(fibre[static_cast<std::size_t>(e)],
-                                      fibre[static_cast<std::size_t>(nearest)]);
+        j < 0 ? std::numeric_limits<double>::quiet_NaN()
+              : shear_angle_deg(fibre[static_cast<std::size_t>(e)], fibre[static_cast<std::size_t>(j)]);
   }
 }
 

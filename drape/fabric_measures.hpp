@@ -14,6 +14,13 @@
 
 namespace ncfsim::drape {
 
+/// For every element of `ply_a` (indices into centroid), writes into nearest[e] the element of
+/// `ply_b` whose centroid is nearest (within `reach` m; -1 where none is). nearest is sized like
+/// centroid.
+void nearest_in_other_ply(const std::vector<fem::V3>& centroid, const std::vector<std::int32_t>& ply_a,
+                          const std::vector<std::int32_t>& ply_b, double reach,
+                          std::vector<std::int32_t>& nearest);
+
 /// For every element of `ply_a` (indices into centroid/fibre), writes into shear_deg[e] the shear
 /// angle against the nearest element of `ply_b` (within `reach` m of its centroid; NaN where none
 /// is). shear_deg must be sized like centroid.

@@ -44,6 +44,7 @@ struct FabricSummary {
   double tow_thickness = 0;
   // Index of its stitch-to-tow connection in model.contacts (-1: none).
   int connection_contact = -1;
+  std::vector<int> ply_parts;  // part index per ply (hexahedra)
 };
 
 }  // namespace ncfsim::drape

@@ -19,6 +19,14 @@
 
 namespace ncfsim::fem {
 
+/// A cell field a measure adds to the result frames: values [n_components * (n_hex + n_bar)],
+/// hexahedra first, then bars (the results files' cell order); NaN where it does not apply.
+struct MeasureCellField {
+  std::string name;
+  int n_components = 1;
+  std::vector<double> values;
+};
+
 class RunMeasure {
  public:
   virtual ~RunMeasure() = default;
@@ -44,6 +52,11 @@ class RunMeasure {
   /// Writes its summary.json entries at the solver's current state (called at every frame and
   /// once at the end). A value that could not be measured is null.
   virtual void add_summary(const ExplicitSolver& s, nlohmann::json& summary) const { (void)s, (void)summary; }
+  /// At every result frame: cell fields of its own. Several measures may fill one field (one
+  /// fabric each): a measure adds the field if it is not there yet and fills its own cells.
+  virtual void add_frame_fields(const ExplicitSolver& s, std::vector<MeasureCellField>& fields) const {
+    (void)s, (void)fields;
+  }
   /// Once at the end of the run: files of its own in the output folder (written atomically),
   /// e.g. a drape's ring_shear.csv. Returns the file names it wrote.
   virtual std::vector<std::string> write_files(const ExplicitSolver& s, const std::filesystem::path& dir) const {

@@ -207,7 +207,8 @@ std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx, const 
           std::make_unique<StitchToTowConnection>(fe.name + "_stitch_tow", fe.model.connections, fe.connection));
     }
     summaries.push_back({fe.name, fe.model.n_tows, fe.model.n_dropped_tows, fe.model.n_penetrations,
-                         fe.model.connections.size(), fe.model.tow_thickness, connection_contact});
+                         fe.model.connections.size(), fe.model.tow_thickness, connection_contact,
+                         fe.model.ply_parts});
   }
   return summaries;
 }

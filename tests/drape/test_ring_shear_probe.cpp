@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "drape/probes/fabric_fields.hpp"
 #include "drape/probes/ring_shear_probe.hpp"
+#include "fem/elements/hex8_block.hpp"
 #include "fem/errors.hpp"
 #include "fem/solver.hpp"
 #include "workflow/case/engine_case.hpp"
@@ -110,5 +112,72 @@ TEST(RingShearProbe, OnlyOneRingAndTwoPlies) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("ring_shear"), std::string::npos) << e.what();
   }
+  fs::remove(file);
+}
+
+// The fabric's element fields (drape/probes/fabric_fields.hpp) on the flat +-45 blanket: none
+// undeformed; under an in-plane simple shear x' = x + k y of both plies, every element reads the
+// angle the mapped fibres (1, 1) and (1, -1) make, 90 - acos(|Fa.Fb| / |Fa||Fb|), and no slip;
+// then ply 1 moved by d along x: slip d everywhere, the shear unchanged (the fibres stay).
+TEST(FabricFields, ShearAngleAndSlipOfAnAffineDeformation) {
+  const fs::path file = write_case(kCase, "fields_flat");
+  auto ec = workflow::load_engine_case(file, {});
+  ASSERT_EQ(ec.fabric_summaries.size(), 1u);
+  const auto& f = ec.fabric_summaries[0];
+  ASSERT_EQ(f.ply_parts.size(), 2u);
+  fem::ExplicitSolver solver(ec.model);
+  const drape::FabricFields m(f.name, f.ply_parts[0], f.ply_parts[1], solver);
+  auto finite_values = [](const std::vector<double>& v) {
+    std::vector<double> out;
+    for (double e : v)
+      if (std::isfinite(e)) out.push_back(e);
+    return out;
+  };
+  auto v = m.values(solver);
+  const std::size_t n = v.shear_deg.size();
+  ASSERT_GT(n, 100u);
+  ASSERT_EQ(finite_values(v.shear_deg).size(), n) << "every element finds the other ply";
+  for (double e : v.shear_deg) EXPECT_NEAR(e, 0.0, 1e-9);
+  for (double e : v.slip_m) EXPECT_NEAR(e, 0.0, 1e-15);
+
+  const double k = 0.3;
+  {
+    auto X = solver.x.view();
+    for (std::size_t i = 0; i < X.size() / 3; ++i) X[3 * i] += k * X[3 * i + 1];
+  }
+  const double c = std::abs((1 + k) * (1 - k) - 1.0) / (std::hypot(1 + k, 1.0) * std::hypot(1 - k, 1.0));
+  const double expected = 90.0 - std::acos(c) * 180.0 / M_PI;  // 16.6 deg at k = 0.3
+  v = m.values(solver);
+  for (double e : v.shear_deg) EXPECT_NEAR(e, expected, 1e-6);
+  for (double e : v.slip_m) EXPECT_NEAR(e, 0.0, 1e-12);
+
+  const double d = 1.0e-3;  // less than half an element: the neighbours stay the same
+  {
+    auto X = solver.x.view();
+    std::vector<char> in_ply1(X.size() / 3, 0);
+    for (const auto& b : solver.blocks<fem::Hex8Block>())
+      if (b.part == f.ply_parts[0])
+        for (std::size_t I = 0; I < 8 * b.n; ++I) in_ply1[static_cast<std::size_t>(b.conn[I])] = 1;
+    for (std::size_t i = 0; i < in_ply1.size(); ++i)
+      if (in_ply1[i]) X[3 * i] += d;
+  }
+  v = m.values(solver);
+  for (double e : v.shear_deg) EXPECT_NEAR(e, expected, 1e-6);
+  for (double e : v.slip_m) EXPECT_NEAR(e, d, 1e-12);
+
+  // In the frames: one field each, NaN on the stitch bars.
+  std::vector<fem::MeasureCellField> fields;
+  m.add_frame_fields(solver, fields);
+  ASSERT_EQ(fields.size(), 2u);
+  EXPECT_EQ(fields[0].name, "shear_angle_deg");
+  EXPECT_EQ(fields[1].name, "interply_slip_m");
+  const std::size_t nh = solver.n_elements(fem::ElementKind::Hex8), nb = solver.n_elements(fem::ElementKind::Bar2);
+  ASSERT_EQ(fields[0].values.size(), nh + nb);
+  EXPECT_EQ(finite_values(fields[0].values).size(), n);
+  EXPECT_TRUE(std::isnan(fields[0].values[nh + nb - 1]));
+  nlohmann::json s;
+  m.add_summary(solver, s);
+  EXPECT_NEAR(s["fabrics"]["ncf"]["max_shear_deg"].get<double>(), expected, 1e-6);
+  EXPECT_NEAR(s["fabrics"]["ncf"]["max_interply_slip_m"].get<double>(), d, 1e-12);
   fs::remove(file);
 }

@@ -42,6 +42,8 @@ std::string unit_of(const std::string& field) {
   if (field == "displacement" || field == "displacement_magnitude") return "m";
   if (field == "velocity") return "m/s";
   if (field == "axial_force") return "N";
+  if (field == "shear_angle_deg") return "deg";
+  if (field == "interply_slip_m") return "m";
   return "-";
 }
 

@@ -54,9 +54,12 @@ class FrameOutput {
     if (o.xdmf) xdmf_ = std::make_unique<fem::io::XdmfResultWriter>(dir, mesh);
     if (o.vtu) vtu_ = std::make_unique<fem::io::VtuSeriesWriter>(dir, mesh);
   }
-  void write(const fem::ExplicitSolver& s, spdlog::logger& log) {
+  void write(const fem::ExplicitSolver& s, const MeasureList& measures, spdlog::logger& log) {
     if (!xdmf_ && !vtu_) return;
-    const fem::io::Frame fr = make_frame(s);
+    fem::io::Frame fr = make_frame(s);
+    std::vector<fem::MeasureCellField> extra;
+    for (const auto& m : measures) m->add_frame_fields(s, extra);
+    for (auto& f : extra) fr.fields.push_back({std::move(f.name), true, f.n_components, std::move(f.values)});
     try {
       if (xdmf_) xdmf_->write_frame(fr);
       if (vtu_) vtu_->write_frame(fr);
@@ -208,7 +211,7 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
           }
         }
         if (t >= next_frame) {
-          frames.write(solver, *r.log);
+          frames.write(solver, measures, *r.log);
           fill_summary(r, solver, measures, history, frames);
           r.summary["status"] = "running";
           r.write_summary();
@@ -222,7 +225,7 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
     }
     // Final state (positions at the end time; forces of the last cycle).
     history.write_row(solver);
-    frames.write(solver, *r.log);
+    frames.write(solver, measures, *r.log);
   } catch (const NumericalError& e) {
     r.status = "numerical_failure";
     r.failure = e.what();

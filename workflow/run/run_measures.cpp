@@ -4,6 +4,7 @@
 
 #include "drape/probes/bending_length_probe.hpp"
 #include "drape/probes/bias_extension_curve.hpp"
+#include "drape/probes/fabric_fields.hpp"
 #include "drape/probes/fabric_report.hpp"
 #include "drape/probes/picture_frame_force.hpp"
 #include "drape/probes/ring_shear_probe.hpp"
@@ -170,6 +171,10 @@ MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s
   if (auto curve = make_bias_extension_curve(ec)) m.push_back(std::move(curve));
   m.push_back(std::make_unique<ContactResultants>());
   if (!ec.fabric_summaries.empty()) m.push_back(std::make_unique<drape::FabricReport>(ec.fabric_summaries, model));
+  // After the report, which writes each fabric's summary entry anew.
+  for (const auto& f : ec.fabric_summaries)
+    if (f.ply_parts.size() == 2)
+      m.push_back(std::make_unique<drape::FabricFields>(f.name, f.ply_parts[0], f.ply_parts[1], s));
   return m;
 }
 

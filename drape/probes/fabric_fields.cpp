@@ -1,0 +1,149 @@
+#include "drape/probes/fabric_fields.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "drape/fabric_measures.hpp"
+#include "drape/kinematic_drape.hpp"
+#include "fem/elements/element_fields.hpp"
+#include "fem/elements/hex8_block.hpp"
+
+namespace ncfsim::drape {
+
+using fem::V3;
+
+FabricFields::FabricFields(std::string name, int ply_a, int ply_b, const fem::ExplicitSolver& s)
+    : name_(std::move(name)) {
+  auto X0 = s.x0.view();
+  double longest = 0;
+  const auto& blocks = s.blocks<fem::Hex8Block>();
+  for (int side = 0; side < 2; ++side) {
+    const int part = side == 0 ? ply_a : ply_b;
+    std::size_t offset = 0;  // hexahedra come first in the results files, block after block
+    for (std::size_t k = 0; k < blocks.size(); offset += blocks[k].n, ++k) {
+      const auto& b = blocks[k];
+      if (b.part != part) continue;
+      for (std::size_t e = 0; e < b.n; ++e) {
+        elements_.emplace_back(k, e);
+        cell_.push_back(offset + e);
+        std::array<std::int32_t, 8> c{};
+        V3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+        for (std::size_t I = 0; I < 8; ++I) {
+          c[I] = b.conn[I * b.n + e];
+          const V3 p = V3::at(X0.data() + 3 * static_cast<std::size_t>(c[I]));
+          lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+          hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+        }
+        longest = std::max(longest, norm(hi - lo));
+        conn_.push_back(c);
+      }
+    }
+    if (side == 0) n_a_ = elements_.size();
+  }
+  reach_ = 1.5 * longest;  // the nearest element of the other ply lies within a diagonal
+}
+
+namespace {
+
+// Mid-surface of a tow hexahedron (VTK order: 0-3 one face, 4-7 the other): a bilinear quad.
+struct MidQuad {
+  V3 c[4];
+  MidQuad(const std::array<std::int32_t, 8>& h, const double* x) {
+    for (std::size_t k = 0; k < 4; ++k)
+      c[k] = 0.5 * (V3::at(x + 3 * static_cast<std::size_t>(h[k])) +
+                    V3::at(x + 3 * static_cast<std::size_t>(h[k + 4])));
+  }
+  V3 at(double r, double t) const {
+    return 0.25 * ((1 - r) * (1 - t) * c[0] + (1 + r) * (1 - t) * c[1] + (1 + r) * (1 + t) * c[2] +
+                   (1 - r) * (1 + t) * c[3]);
+  }
+  V3 d_r(double t) const { return 0.25 * ((1 - t) * (c[1] - c[0]) + (1 + t) * (c[2] - c[3])); }
+  V3 d_t(double r) const { return 0.25 * ((1 - r) * (c[3] - c[0]) + (1 + r) * (c[2] - c[1])); }
+};
+
+// Natural coordinates of the point of the quad nearest to p (Gauss-Newton; exact in one step on
+// a parallelogram, which an affinely deformed element's mid-surface is).
+std::pair<double, double> natural_coordinates(const MidQuad& q, const V3& p) {
+  double r = 0, t = 0;
+  for (int it = 0; it < 8; ++it) {
+    const V3 res = q.at(r, t) - p, a = q.d_r(t), b = q.d_t(r);
+    const double aa = dot(a, a), ab = dot(a, b), bb = dot(b, b), det = aa * bb - ab * ab;
+    if (!(std::abs(det) > 0)) break;
+    const double ga = dot(a, res), gb = dot(b, res);
+    const double dr = (bb * ga - ab * gb) / det, dt = (aa * gb - ab * ga) / det;
+    r -= dr, t -= dt;
+    if (std::abs(dr) + std::abs(dt) < 1e-12) break;
+  }
+  return {r, t};
+}
+
+}  // namespace
+
+FabricFields::Values FabricFields::values(const fem::ExplicitSolver& s) const {
+  auto X = s.x.view();
+  auto X0 = s.x0.view();
+  const std::size_t n = elements_.size();
+  std::vector<V3> centroid(n), fibre(n);
+  std::vector<std::int32_t> a, b;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& [k, e] = elements_[i];
+    const auto& blk = s.blocks<fem::Hex8Block>()[k];
+    if (blk.n_eroded && blk.eroded[e]) continue;
+    for (auto node : conn_[i]) centroid[i] += 0.125 * V3::at(X.data() + 3 * static_cast<std::size_t>(node));
+    double d[3];
+    fem::hex8_fibre_direction(blk, X.data(), e, d);
+    fibre[i] = {d[0], d[1], d[2]};
+    (i < n_a_ ? a : b).push_back(static_cast<std::int32_t>(i));
+  }
+  std::vector<std::int32_t> nearest(n, -1);
+  nearest_in_other_ply(centroid, a, b, reach_, nearest);
+  nearest_in_other_ply(centroid, b, a, reach_, nearest);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Values v{std::vector<double>(n, nan), std::vector<double>(n, nan)};
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t j = nearest[i];
+    if (j < 0) continue;
+    v.shear_deg[i] = shear_angle_deg(fibre[i], fibre[static_cast<std::size_t>(j)]);
+    // The material point of the other ply now under this element's centre, in its reference
+    // state, against the one that lay under it: their distance in the ply plane is the slip.
+    const auto& hj = conn_[static_cast<std::size_t>(j)];
+    const MidQuad now_j(hj, X.data()), ref_j(hj, X0.data()), ref_i(conn_[i], X0.data());
+    const auto [r, t] = natural_coordinates(now_j, centroid[i]);
+    const V3 n0 = normalized(cross(ref_j.d_r(0), ref_j.d_t(0)));
+    V3 d = ref_j.at(r, t) - ref_i.at(0, 0);
+    d -= dot(d, n0) * n0;
+    v.slip_m[i] = norm(d);
+  }
+  return v;
+}
+
+void FabricFields::add_frame_fields(const fem::ExplicitSolver& s,
+                                    std::vector<fem::MeasureCellField>& fields) const {
+  const std::size_t n_cells = s.n_elements(fem::ElementKind::Hex8) + s.n_elements(fem::ElementKind::Bar2);
+  auto field = [&](const char* name) -> std::vector<double>& {
+    for (auto& f : fields)
+      if (f.name == name) return f.values;
+    fields.push_back({name, 1, std::vector<double>(n_cells, std::numeric_limits<double>::quiet_NaN())});
+    return fields.back().values;
+  };
+  const Values v = values(s);
+  auto& shear = field("shear_angle_deg");
+  for (std::size_t i = 0; i < cell_.size(); ++i) shear[cell_[i]] = v.shear_deg[i];
+  auto& slip = field("interply_slip_m");
+  for (std::size_t i = 0; i < cell_.size(); ++i) slip[cell_[i]] = v.slip_m[i];
+}
+
+void FabricFields::add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const {
+  const Values v = values(s);
+  auto max_of = [](const std::vector<double>& x) {
+    double m = std::numeric_limits<double>::quiet_NaN();
+    for (double e : x)
+      if (std::isfinite(e) && !(e <= m)) m = e;
+    return m;
+  };
+  summary["fabrics"][name_]["max_shear_deg"] = fem::json_number(max_of(v.shear_deg));
+  summary["fabrics"][name_]["max_interply_slip_m"] = fem::json_number(max_of(v.slip_m));
+}
+
+}  // namespace ncfsim::drape

@@ -1,0 +1,44 @@
+#pragma once
+// Element fields of a two-ply fabric in the result frames (issue #18's results): at every frame,
+// for each tow hexahedron of the two plies,
+//  * shear_angle_deg: the inter-ply shear angle, 90 deg minus the angle between its convected
+//    fibre direction and that of the nearest element (current centroids) of the other ply: what
+//    an engineer reads off a formed part (the paper's Fig. 18 measure, everywhere);
+//  * interply_slip_m: the slip of the ply over the other (cross-over sliding) at that place: the
+//    material point of the other ply now under the element's centre (found in the nearest element
+//    of the other ply by inverting its bilinear mid-surface) is taken back to its reference
+//    position, and its distance in the ply plane from the element centre's reference position is
+//    the slip. Exact under an affine deformation of the two plies; otherwise to the accuracy of a
+//    bilinear field over one element.
+// summary.json: fabrics.<name>.max_shear_deg, fabrics.<name>.max_interply_slip_m (final state).
+#include <array>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fem/run_measure.hpp"
+
+namespace ncfsim::drape {
+
+class FabricFields final : public fem::RunMeasure {
+ public:
+  /// The fabric `name` whose plies are the parts ply_a, ply_b (hexahedra).
+  FabricFields(std::string name, int ply_a, int ply_b, const fem::ExplicitSolver& s);
+  void add_frame_fields(const fem::ExplicitSolver& s, std::vector<fem::MeasureCellField>& fields) const override;
+  void add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const override;
+
+  struct Values {
+    std::vector<double> shear_deg, slip_m;  // per element of the plies (ply a, then b)
+  };
+  Values values(const fem::ExplicitSolver& s) const;
+
+ private:
+  std::string name_;
+  std::vector<std::pair<std::size_t, std::size_t>> elements_;  // (hex block, element), ply a then b
+  std::vector<std::size_t> cell_;                               // results-file cell index of each
+  std::size_t n_a_ = 0;
+  std::vector<std::array<std::int32_t, 8>> conn_;
+  double reach_ = 0;
+};
+
+}  // namespace ncfsim::drape
