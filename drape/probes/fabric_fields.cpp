@@ -42,6 +42,45 @@ FabricFields::FabricFields(std::string name, int ply_a, int ply_b, const fem::Ex
     if (side == 0) n_a_ = elements_.size();
   }
   reach_ = 1.5 * longest;  // the nearest element of the other ply lies within a diagonal
+
+  // The blank's outline: nodes of the plies within half an element of its rectangle's edges.
+  if (conn_.empty()) return;
+  const auto& h0 = conn_[0];
+  auto X0at = [&](std::int32_t node) { return V3::at(X0.data() + 3 * static_cast<std::size_t>(node)); };
+  normal_ = normalized(cross(X0at(h0[1]) - X0at(h0[0]), X0at(h0[3]) - X0at(h0[0])));
+  V3 e1 = normalized(cross(normal_, std::abs(normal_.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}));
+  if (std::abs(normal_.z) > 0.9) e1 = {1, 0, 0};  // a blank in a horizontal plane: x, y edges
+  const V3 e2 = cross(normal_, e1);
+  std::vector<std::int32_t> nodes;
+  for (const auto& h : conn_) nodes.insert(nodes.end(), h.begin(), h.end());
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (auto nd : nodes) {
+    const V3 p = X0at(nd);
+    const double u[2] = {dot(p, e1), dot(p, e2)};
+    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], u[k]), hi[k] = std::max(hi[k], u[k]);
+  }
+  centre_ = 0.5 * (lo[0] + hi[0]) * e1 + 0.5 * (lo[1] + hi[1]) * e2;
+  const double tol = 0.5 * longest;
+  const double mids[4][2] = {{hi[0], 0.5 * (lo[1] + hi[1])}, {0.5 * (lo[0] + hi[0]), hi[1]},
+                             {lo[0], 0.5 * (lo[1] + hi[1])}, {0.5 * (lo[0] + hi[0]), lo[1]}};
+  const double corners[4][2] = {{hi[0], hi[1]}, {lo[0], hi[1]}, {lo[0], lo[1]}, {hi[0], lo[1]}};
+  double best_mid[4], best_corner[4];
+  std::fill(best_mid, best_mid + 4, 1e300);
+  std::fill(best_corner, best_corner + 4, 1e300);
+  for (auto nd : nodes) {
+    const V3 p = X0at(nd);
+    const double u = dot(p, e1), w = dot(p, e2);
+    if (std::min({u - lo[0], hi[0] - u, w - lo[1], hi[1] - w}) > tol) continue;
+    outline_.push_back(nd);
+    for (std::size_t k = 0; k < 4; ++k) {
+      const double dm = std::hypot(u - mids[k][0], w - mids[k][1]);
+      const double dc = std::hypot(u - corners[k][0], w - corners[k][1]);
+      if (dm < best_mid[k]) best_mid[k] = dm, mid_edge_[k] = nd;
+      if (dc < best_corner[k]) best_corner[k] = dc, corner_[k] = nd;
+    }
+  }
 }
 
 namespace {
@@ -144,6 +183,23 @@ void FabricFields::add_summary(const fem::ExplicitSolver& s, nlohmann::json& sum
   };
   summary["fabrics"][name_]["max_shear_deg"] = fem::json_number(max_of(v.shear_deg));
   summary["fabrics"][name_]["max_interply_slip_m"] = fem::json_number(max_of(v.slip_m));
+  if (outline_.empty()) return;
+  auto X = s.x.view();
+  auto X0 = s.x0.view();
+  auto draw_in = [&](std::int32_t nd) {
+    const std::size_t o = 3 * static_cast<std::size_t>(nd);
+    auto in_plane = [&](V3 p) {
+      p -= centre_;
+      return norm(p - dot(p, normal_) * normal_);
+    };
+    return in_plane(V3::at(X0.data() + o)) - in_plane(V3::at(X.data() + o));
+  };
+  double most = -1e300, mid = 0, corner = 0;
+  for (auto nd : outline_) most = std::max(most, draw_in(nd));
+  for (std::size_t k = 0; k < 4; ++k) mid += 0.25 * draw_in(mid_edge_[k]), corner += 0.25 * draw_in(corner_[k]);
+  summary["fabrics"][name_]["draw_in_max_m"] = fem::json_number(most);
+  summary["fabrics"][name_]["draw_in_mid_edge_m"] = fem::json_number(mid);
+  summary["fabrics"][name_]["draw_in_corner_m"] = fem::json_number(corner);
 }
 
 }  // namespace ncfsim::drape

@@ -10,7 +10,11 @@
 //    position, and its distance in the ply plane from the element centre's reference position is
 //    the slip. Exact under an affine deformation of the two plies; otherwise to the accuracy of a
 //    bilinear field over one element.
-// summary.json: fabrics.<name>.max_shear_deg, fabrics.<name>.max_interply_slip_m (final state).
+// summary.json: fabrics.<name>.max_shear_deg, fabrics.<name>.max_interply_slip_m (final state),
+// and the draw-in of the blank's outline (the nodes of the plies on the edge of the blank's
+// rectangle in its plane): how much nearer to the blank's centre, in that plane, each has come:
+// draw_in_max_m, draw_in_mid_edge_m (mean at the four edge mid-points), draw_in_corner_m (mean
+// at the four corners).
 #include <array>
 #include <string>
 #include <utility>
@@ -39,6 +43,11 @@ class FabricFields final : public fem::RunMeasure {
   std::size_t n_a_ = 0;
   std::vector<std::array<std::int32_t, 8>> conn_;
   double reach_ = 0;
+  // Draw-in: the blank's plane (centre, normal), its outline nodes, and which of them are nearest
+  // to the four edge mid-points and the four corners.
+  fem::V3 centre_, normal_;
+  std::vector<std::int32_t> outline_;
+  std::array<std::int32_t, 4> mid_edge_{}, corner_{};
 };
 
 }  // namespace ncfsim::drape

@@ -181,3 +181,29 @@ TEST(FabricFields, ShearAngleAndSlipOfAnAffineDeformation) {
   EXPECT_NEAR(s["fabrics"]["ncf"]["max_interply_slip_m"].get<double>(), d, 1e-12);
   fs::remove(file);
 }
+
+// Draw-in of the blank's outline: none undeformed; a uniform in-plane shrink by a factor (1 - c)
+// about the blank's centre (30, 30) mm brings each outline node nearer by c times its distance:
+// the 30 mm to the edge mid-points, 42.4 mm to the corners.
+TEST(FabricFields, DrawInOfTheOutline) {
+  const fs::path file = write_case(kCase, "fields_drawin");
+  auto ec = workflow::load_engine_case(file, {});
+  const auto& f = ec.fabric_summaries.at(0);
+  fem::ExplicitSolver solver(ec.model);
+  const drape::FabricFields m(f.name, f.ply_parts[0], f.ply_parts[1], solver);
+  nlohmann::json s;
+  m.add_summary(solver, s);
+  EXPECT_NEAR(s["fabrics"]["ncf"]["draw_in_max_m"].get<double>(), 0.0, 1e-15);
+  const double c = 0.1;
+  {
+    auto X = solver.x.view();
+    for (std::size_t i = 0; i < X.size() / 3; ++i)
+      for (int k = 0; k < 2; ++k) X[3 * i + k] = 0.03 + (1 - c) * (X[3 * i + k] - 0.03);
+  }
+  m.add_summary(solver, s);
+  const auto& fab = s["fabrics"]["ncf"];
+  EXPECT_NEAR(fab["draw_in_mid_edge_m"].get<double>(), c * 0.03, 0.05 * c * 0.03);
+  EXPECT_NEAR(fab["draw_in_corner_m"].get<double>(), c * 0.03 * std::sqrt(2.0), 0.05 * c * 0.03);
+  EXPECT_NEAR(fab["draw_in_max_m"].get<double>(), c * 0.03 * std::sqrt(2.0), 0.05 * c * 0.03);
+  fs::remove(file);
+}
