@@ -35,6 +35,11 @@ struct BendingLengthProbe {
 struct RingShearProbe {
   int part_a = -1, part_b = -1;
   RingSpec ring;
+  // The kinematic (pin-jointed net) drape of a kinematic_drape case on the same ring, computed
+  // once when the case is read (empty: none): the ring CSV's kinematic_shear_deg column and the
+  // summary's kinematic_max_shear_deg_q1..q4, beside the meso ones.
+  std::string kinematic_case;
+  std::vector<RingSample> kinematic;
 };
 
 /// What a [[mesh.fabric]] generated (echoed in the log and summary.json).

@@ -1,7 +1,11 @@
+#include <cmath>
+#include <filesystem>
 // The fabric-test probes of [output] and the bias-extension sample's coupon.
 #include <tuple>
 
 #include "drape/case/drape_case.hpp"
+#include "drape/case/kinematic_case.hpp"
+#include "drape/kinematic_drape.hpp"
 #include "fem/case/fem_case.hpp"
 
 namespace ncfsim::drape {
@@ -57,6 +61,19 @@ std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& c
     RingShearProbe rp;
     std::tie(rp.part_a, rp.part_b) = two_plies(t, mesh);
     read_ring(t, rp.ring);
+    if (t.has("kinematic_case")) {
+      std::filesystem::path kf = t.string("kinematic_case");
+      if (kf.is_relative()) kf = t.file().parent_path() / kf;
+      if (!std::filesystem::is_regular_file(kf))
+        t.fail("kinematic_case", "no such case file: " + kf.string());
+      const KinematicDrapeCase kc = load_kinematic_drape_case(kf, {});
+      if (std::abs(kc.ring.height - rp.ring.height) > 1e-9)
+        t.fail("kinematic_case", "its ring height (" + std::to_string(kc.ring.height) +
+                                     " m) differs from this ring's (" + std::to_string(rp.ring.height) + " m)");
+      const KinematicNet net = kinematic_drape(kc.surface, kc.net);
+      rp.kinematic_case = kf.string();
+      rp.kinematic = ring_shear(net.x, net.triangles(), net.shear_deg, rp.ring);
+    }
     out.push_back(rp);
   }
   return out;

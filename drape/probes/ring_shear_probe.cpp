@@ -49,9 +49,16 @@ RingShearMeasure::RingShearMeasure(const RingShearProbe& spec, const fem::Explic
 }
 
 std::vector<std::string> RingShearMeasure::setup_lines() const {
-  return {fmt::format(
+  std::vector<std::string> lines{fmt::format(
       "ring shear: {} + {} tow elements, {} outer-face triangles, ring {:.4g} m above the plane",
       n_a_, elements_.size() - n_a_, faces_.size(), spec_.ring.height)};
+  if (!spec_.kinematic.empty()) {
+    const auto q = quadrant_maxima(spec_.kinematic);
+    lines.push_back(fmt::format("ring shear, kinematic drape of {}: max q1 {:.2f}, q2 {:.2f}, q3 {:.2f}, q4 {:.2f} deg",
+                                spec_.kinematic_case, q.max_shear_deg[0], q.max_shear_deg[1],
+                                q.max_shear_deg[2], q.max_shear_deg[3]));
+  }
+  return lines;
 }
 
 std::vector<RingSample> RingShearMeasure::ring(const fem::ExplicitSolver& s) const {
@@ -88,11 +95,31 @@ void RingShearMeasure::add_summary(const fem::ExplicitSolver& s, nlohmann::json&
   for (std::size_t k = 0; k < 4; ++k)
     summary[fmt::format("max_shear_deg_q{}", k + 1)] =
         q.samples[k] > 0 ? fem::json_number(q.max_shear_deg[k]) : nullptr;
+  if (spec_.kinematic.empty()) return;
+  const auto qk = quadrant_maxima(spec_.kinematic);
+  for (std::size_t k = 0; k < 4; ++k)
+    summary[fmt::format("kinematic_max_shear_deg_q{}", k + 1)] =
+        qk.samples[k] > 0 ? fem::json_number(qk.max_shear_deg[k]) : nullptr;
 }
 
 std::vector<std::string> RingShearMeasure::write_files(const fem::ExplicitSolver& s,
                                                        const std::filesystem::path& dir) const {
-  fem::io::atomic_write_text(dir / "ring_shear.csv", ring_csv(ring(s), "shear_deg"));
+  std::string csv = ring_csv(ring(s), "shear_deg");
+  if (!spec_.kinematic.empty()) {  // the kinematic drape's shear at the same azimuths, last column
+    std::string out;
+    std::size_t row = 0, pos = 0;
+    for (std::size_t nl; (nl = csv.find('\n', pos)) != std::string::npos; pos = nl + 1, ++row) {
+      out += csv.substr(pos, nl - pos);
+      if (row == 0) {
+        out += ",kinematic_shear_deg\n";
+      } else {
+        const auto& k = spec_.kinematic[row - 1];
+        out += fmt::format(",{:.9g}\n", k.hit ? k.shear_deg : std::nan(""));
+      }
+    }
+    csv = std::move(out);
+  }
+  fem::io::atomic_write_text(dir / "ring_shear.csv", csv);
   return {"ring_shear.csv"};
 }
 

@@ -100,7 +100,8 @@ PlotSpec read_plot(const TableReader& t) {
   PlotSpec p;
   p.name = t.string("name");
   p.title = t.string("title", p.name);
-  p.x = t.string("x", "time");
+  p.source = t.choice("source", {"history.csv", "ring_shear.csv"}, "history.csv");
+  p.x = t.string("x", p.source == "ring_shear.csv" ? "azimuth_deg" : "time");
   p.y = t.strings("y");
   p.x_scale = t.number("x_scale", 1.0, {});
   p.y_scale = t.number("y_scale", 1.0, {});

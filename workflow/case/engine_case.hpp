@@ -86,6 +86,7 @@ struct PlotSpec {
   std::string x_label, y_label;
   std::vector<ImportedSeries> imports;
   std::vector<ReferenceLine> references;
+  std::string source = "history.csv";  // the run's CSV file the columns come from
 };
 
 /// A picture of the last frame coloured by a field.

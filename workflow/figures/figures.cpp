@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "fem/io/result_reader.hpp"
@@ -34,6 +35,7 @@ json plot_json(const PlotSpec& p) {
           {"x_label", p.x_label},
           {"y_label", p.y_label},
           {"imports", imports},
+          {"source", p.source},
           {"references", refs}};
 }
 
@@ -143,10 +145,16 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
   std::vector<std::filesystem::path> out;
   std::filesystem::create_directories(dir / "figures");
 
-  if (std::filesystem::exists(dir / "history.csv")) {
-    const CsvTable h = read_csv(dir / "history.csv");
+  {
+    std::map<std::string, CsvTable> sources;  // the run's CSV files, read once each
     for (const auto& p : spec.at("plots")) {
       const std::string name = p.at("name");
+      const std::string source = p.value("source", std::string("history.csv"));
+      if (!sources.count(source)) {
+        if (!std::filesystem::exists(dir / source)) continue;
+        sources.emplace(source, read_csv(dir / source));
+      }
+      const CsvTable& h = sources.at(source);
       try {
         render::CurvePlot plot;
         plot.title = p.at("title");
@@ -160,7 +168,7 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
           for (double& v : y) v *= ys;
           plot.series.push_back({yname.get<std::string>(), x, y});
         }
-        if (h.rows.size() < 2) throw std::runtime_error("fewer than 2 rows in history.csv");
+        if (h.rows.size() < 2) throw std::runtime_error("fewer than 2 rows in " + source);
         for (const auto& im : p.value("imports", json::array())) {
           const CsvTable t = read_csv(im.at("file").get<std::string>());
           auto ix = t.column(im.at("x")), iy = t.column(im.at("y"));
