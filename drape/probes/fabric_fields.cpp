@@ -6,6 +6,7 @@
 
 #include "drape/fabric_measures.hpp"
 #include "drape/kinematic_drape.hpp"
+#include "fem/contact/bucket_grid.hpp"
 #include "fem/elements/element_fields.hpp"
 #include "fem/elements/hex8_block.hpp"
 
@@ -42,6 +43,7 @@ FabricFields::FabricFields(std::string name, int ply_a, int ply_b, const fem::Ex
     if (side == 0) n_a_ = elements_.size();
   }
   reach_ = 1.5 * longest;  // the nearest element of the other ply lies within a diagonal
+  wrinkle_radius_ = 3.0 * longest;
 
   // The blank's outline: nodes of the plies within half an element of its rectangle's edges.
   if (conn_.empty()) return;
@@ -117,19 +119,50 @@ std::pair<double, double> natural_coordinates(const MidQuad& q, const V3& p) {
   return {r, t};
 }
 
+// Angle (deg) between each element's normal and the mean normal of the elements of its own ply
+// with centroids within `radius` (itself included).
+void wrinkle_angles(const std::vector<V3>& centroid, const std::vector<V3>& normal,
+                    const std::vector<std::int32_t>& ply, double radius, std::vector<double>& out) {
+  if (ply.empty()) return;
+  std::vector<double> lo(3 * ply.size()), hi(3 * ply.size());
+  for (std::size_t k = 0; k < ply.size(); ++k) {
+    const auto c = centroid[static_cast<std::size_t>(ply[k])].arr();
+    for (std::size_t d = 0; d < 3; ++d) lo[3 * k + d] = c[d] - radius, hi[3 * k + d] = c[d] + radius;
+  }
+  fem::BucketGrid grid;
+  grid.build(ply.size(), lo.data(), hi.data());
+  for (auto e : ply) {
+    const V3 p = centroid[static_cast<std::size_t>(e)], ne = normal[static_cast<std::size_t>(e)];
+    const double q[3] = {p.x, p.y, p.z};
+    std::int32_t begin = 0, end = 0;
+    V3 sum;
+    if (grid.cell_of(q, begin, end))
+      for (std::int32_t it = begin; it < end; ++it) {
+        const auto j = static_cast<std::size_t>(ply[static_cast<std::size_t>(grid.items()[it])]);
+        const V3 d = centroid[j] - p;
+        if (dot(d, d) > radius * radius) continue;
+        sum += dot(normal[j], ne) >= 0 ? normal[j] : -1.0 * normal[j];  // normals of either sense
+      }
+    const V3 m = normalized(sum);  // atan2: accurate near zero, where acos is not
+    out[static_cast<std::size_t>(e)] = std::atan2(norm(cross(m, ne)), dot(m, ne)) * 180.0 / M_PI;
+  }
+}
+
 }  // namespace
 
 FabricFields::Values FabricFields::values(const fem::ExplicitSolver& s) const {
   auto X = s.x.view();
   auto X0 = s.x0.view();
   const std::size_t n = elements_.size();
-  std::vector<V3> centroid(n), fibre(n);
+  std::vector<V3> centroid(n), fibre(n), normal(n);
   std::vector<std::int32_t> a, b;
   for (std::size_t i = 0; i < n; ++i) {
     const auto& [k, e] = elements_[i];
     const auto& blk = s.blocks<fem::Hex8Block>()[k];
     if (blk.n_eroded && blk.eroded[e]) continue;
     for (auto node : conn_[i]) centroid[i] += 0.125 * V3::at(X.data() + 3 * static_cast<std::size_t>(node));
+    const MidQuad mid(conn_[i], X.data());
+    normal[i] = normalized(cross(mid.d_r(0), mid.d_t(0)));
     double d[3];
     fem::hex8_fibre_direction(blk, X.data(), e, d);
     fibre[i] = {d[0], d[1], d[2]};
@@ -139,7 +172,9 @@ FabricFields::Values FabricFields::values(const fem::ExplicitSolver& s) const {
   nearest_in_other_ply(centroid, a, b, reach_, nearest);
   nearest_in_other_ply(centroid, b, a, reach_, nearest);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  Values v{std::vector<double>(n, nan), std::vector<double>(n, nan)};
+  Values v{std::vector<double>(n, nan), std::vector<double>(n, nan), std::vector<double>(n, nan)};
+  wrinkle_angles(centroid, normal, a, wrinkle_radius_, v.wrinkle_deg);
+  wrinkle_angles(centroid, normal, b, wrinkle_radius_, v.wrinkle_deg);
   for (std::size_t i = 0; i < n; ++i) {
     const std::int32_t j = nearest[i];
     if (j < 0) continue;
@@ -171,6 +206,8 @@ void FabricFields::add_frame_fields(const fem::ExplicitSolver& s,
   for (std::size_t i = 0; i < cell_.size(); ++i) shear[cell_[i]] = v.shear_deg[i];
   auto& slip = field("interply_slip_m");
   for (std::size_t i = 0; i < cell_.size(); ++i) slip[cell_[i]] = v.slip_m[i];
+  auto& wrinkle = field("wrinkle_angle_deg");
+  for (std::size_t i = 0; i < cell_.size(); ++i) wrinkle[cell_[i]] = v.wrinkle_deg[i];
 }
 
 void FabricFields::add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const {
@@ -183,6 +220,7 @@ void FabricFields::add_summary(const fem::ExplicitSolver& s, nlohmann::json& sum
   };
   summary["fabrics"][name_]["max_shear_deg"] = fem::json_number(max_of(v.shear_deg));
   summary["fabrics"][name_]["max_interply_slip_m"] = fem::json_number(max_of(v.slip_m));
+  summary["fabrics"][name_]["max_wrinkle_angle_deg"] = fem::json_number(max_of(v.wrinkle_deg));
   if (outline_.empty()) return;
   auto X = s.x.view();
   auto X0 = s.x0.view();

@@ -10,6 +10,11 @@
 //    position, and its distance in the ply plane from the element centre's reference position is
 //    the slip. Exact under an affine deformation of the two plies; otherwise to the accuracy of a
 //    bilinear field over one element.
+//  * wrinkle_angle_deg: out-of-plane waviness, the angle between the element's mid-surface normal
+//    and the mean normal of its own ply's elements within three element lengths (centroids). A
+//    smooth surface of curvature radius rho reads about R / (2 rho) (R the radius of that
+//    neighbourhood: 3 deg for the CI mesh on the 78 mm punch); a wrinkle of shorter wavelength
+//    than 2R reads its slope.
 // summary.json: fabrics.<name>.max_shear_deg, fabrics.<name>.max_interply_slip_m (final state),
 // and the draw-in of the blank's outline (the nodes of the plies on the edge of the blank's
 // rectangle in its plane): how much nearer to the blank's centre, in that plane, each has come:
@@ -32,7 +37,7 @@ class FabricFields final : public fem::RunMeasure {
   void add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const override;
 
   struct Values {
-    std::vector<double> shear_deg, slip_m;  // per element of the plies (ply a, then b)
+    std::vector<double> shear_deg, slip_m, wrinkle_deg;  // per element of the plies (ply a, then b)
   };
   Values values(const fem::ExplicitSolver& s) const;
 
@@ -43,6 +48,7 @@ class FabricFields final : public fem::RunMeasure {
   std::size_t n_a_ = 0;
   std::vector<std::array<std::int32_t, 8>> conn_;
   double reach_ = 0;
+  double wrinkle_radius_ = 0;  // m, the neighbourhood of the wrinkle indicator
   // Draw-in: the blank's plane (centre, normal), its outline nodes, and which of them are nearest
   // to the four edge mid-points and the four corners.
   fem::V3 centre_, normal_;

@@ -168,7 +168,7 @@ TEST(FabricFields, ShearAngleAndSlipOfAnAffineDeformation) {
   // In the frames: one field each, NaN on the stitch bars.
   std::vector<fem::MeasureCellField> fields;
   m.add_frame_fields(solver, fields);
-  ASSERT_EQ(fields.size(), 2u);
+  ASSERT_EQ(fields.size(), 3u);
   EXPECT_EQ(fields[0].name, "shear_angle_deg");
   EXPECT_EQ(fields[1].name, "interply_slip_m");
   const std::size_t nh = solver.n_elements(fem::ElementKind::Hex8), nb = solver.n_elements(fem::ElementKind::Bar2);
@@ -205,5 +205,28 @@ TEST(FabricFields, DrawInOfTheOutline) {
   EXPECT_NEAR(fab["draw_in_mid_edge_m"].get<double>(), c * 0.03, 0.05 * c * 0.03);
   EXPECT_NEAR(fab["draw_in_corner_m"].get<double>(), c * 0.03 * std::sqrt(2.0), 0.05 * c * 0.03);
   EXPECT_NEAR(fab["draw_in_max_m"].get<double>(), c * 0.03 * std::sqrt(2.0), 0.05 * c * 0.03);
+  fs::remove(file);
+}
+
+// Wrinkle indicator: none on the flat blanket; a wave z = A sin(2 pi x / L) shorter than the
+// neighbourhood (L = 20 mm, A = 1 mm: largest slope 2 pi A / L, 17.4 deg) reads close to its
+// slope where it is steepest (the elements' normals average the slope over their length).
+TEST(FabricFields, WrinkleAngleReadsTheSlopeOfAShortWave) {
+  const fs::path file = write_case(kCase, "fields_wrinkle");
+  auto ec = workflow::load_engine_case(file, {});
+  const auto& f = ec.fabric_summaries.at(0);
+  fem::ExplicitSolver solver(ec.model);
+  const drape::FabricFields m(f.name, f.ply_parts[0], f.ply_parts[1], solver);
+  for (double w : m.values(solver).wrinkle_deg) EXPECT_NEAR(w, 0.0, 1e-6);
+  const double A = 1e-3, L = 0.02;
+  {
+    auto X = solver.x.view();
+    for (std::size_t i = 0; i < X.size() / 3; ++i) X[3 * i + 2] += A * std::sin(2 * M_PI * X[3 * i] / L);
+  }
+  const double slope_deg = std::atan(2 * M_PI * A / L) * 180.0 / M_PI;
+  double most = 0;
+  for (double w : m.values(solver).wrinkle_deg) most = std::max(most, w);
+  EXPECT_GT(most, 0.6 * slope_deg);
+  EXPECT_LT(most, 1.2 * slope_deg);
   fs::remove(file);
 }

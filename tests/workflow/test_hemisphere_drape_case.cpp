@@ -58,8 +58,12 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
     EXPECT_GT(v.get<double>(), 5.0) << q;
     EXPECT_LT(v.get<double>(), 60.0) << q;
   }
+  // The pin-jointed net on the same ring (fishnet.toml): four equal quadrants, 26.3 deg.
+  for (int q = 1; q <= 4; ++q)
+    EXPECT_NEAR(s["kinematic_max_shear_deg_q" + std::to_string(q)].get<double>(), 26.28, 0.2) << q;
   const auto ring = read_history(out / "ring_shear.csv");
   ASSERT_EQ(ring.rows.size(), 360u);
+  ASSERT_LT(ring.column("kinematic_shear_deg"), ring.columns.size());
   std::size_t hits = 0;
   for (const auto& row : ring.rows) hits += row[ring.column("hit")] > 0.5;
   EXPECT_GE(hits, 350u);
@@ -93,6 +97,7 @@ TEST(CliHemisphereDrape, BadInputNamesTheKey) {
       {{"tool[1].pressure=-100.0"}, "tool[1].pressure"},
       {{"mesh.fabric[0].size=[0.17,0.17]", "mesh.fabric[0].origin=[-0.085,-0.085,0.0]"},
        "tool[1].radius"},  // the blank is smaller than the die opening
+      {{"output.ring_shear[0].height=0.03"}, "output.ring_shear[0].kinematic_case"},  // other ring
   };
   for (const auto& b : bad) {
     std::vector<std::string> args = {"check", kCase.string(), "--set", "mesh.resolution=coarse"};

@@ -119,7 +119,7 @@ PictureSpec read_picture(const TableReader& t, const fem::Mesh& mesh) {
   p.field = t.choice("field",
                      {"displacement_magnitude", "displacement", "velocity", "stress",
                       "von_mises_stress", "fibre_direction", "axial_force", "axial_strain",
-                      "shear_angle_deg", "interply_slip_m", "none"},
+                      "shear_angle_deg", "interply_slip_m", "wrinkle_angle_deg", "none"},
                      "displacement_magnitude");
   p.component = static_cast<int>(t.integer("component", -1, -1, 5));
   p.camera = t.choice("camera", {"iso", "top", "front"}, "iso");

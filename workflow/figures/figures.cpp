@@ -44,7 +44,7 @@ std::string unit_of(const std::string& field) {
   if (field == "displacement" || field == "displacement_magnitude") return "m";
   if (field == "velocity") return "m/s";
   if (field == "axial_force") return "N";
-  if (field == "shear_angle_deg") return "deg";
+  if (field == "shear_angle_deg" || field == "wrinkle_angle_deg") return "deg";
   if (field == "interply_slip_m") return "m";
   return "-";
 }
