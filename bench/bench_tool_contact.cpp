@@ -44,13 +44,14 @@ void BM_ToolContact(benchmark::State& state) {
     const double t = static_cast<double>(cycle++) * dt;
     punch.displacement = {0, 0, 1.0 * t};  // 1 m/s
     punch.velocity = {0, 0, 1.0};
-    for (std::size_t i = 0; i < n; ++i) x[3 * i + 2] = x0[3 * i + 2] + 1.0 * t;  // the sheet follows
+    for (std::size_t i = 0; i < n; ++i)
+      x[3 * i + 2] = x0[3 * i + 2] + 1.0 * t;  // the sheet follows
     fem::tool_contact_forces(punch, x.data(), v.data(), m.data(), dt, f.data());
     benchmark::DoNotOptimize(f.data());
   }
-  state.counters["ns_per_node_cycle"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * static_cast<double>(n),
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_node_cycle"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * static_cast<double>(n),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["contact_nodes"] = static_cast<double>(n);
   state.counters["near_nodes"] = static_cast<double>(punch.proximity.near.size());
   state.counters["rebuilds"] = static_cast<double>(punch.proximity.n_rebuilds);
@@ -58,5 +59,10 @@ void BM_ToolContact(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_ToolContact)->Args({0, 0})->Args({0, 1})->Args({40, 0})->Args({40, 1})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ToolContact)
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Args({40, 0})
+    ->Args({40, 1})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();

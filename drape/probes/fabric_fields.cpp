@@ -48,7 +48,9 @@ FabricFields::FabricFields(std::string name, int ply_a, int ply_b, const fem::Ex
   // The blank's outline: nodes of the plies within half an element of its rectangle's edges.
   if (conn_.empty()) return;
   const auto& h0 = conn_[0];
-  auto X0at = [&](std::int32_t node) { return V3::at(X0.data() + 3 * static_cast<std::size_t>(node)); };
+  auto X0at = [&](std::int32_t node) {
+    return V3::at(X0.data() + 3 * static_cast<std::size_t>(node));
+  };
   normal_ = normalized(cross(X0at(h0[1]) - X0at(h0[0]), X0at(h0[3]) - X0at(h0[0])));
   V3 e1 = normalized(cross(normal_, std::abs(normal_.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}));
   if (std::abs(normal_.z) > 0.9) e1 = {1, 0, 0};  // a blank in a horizontal plane: x, y edges
@@ -65,8 +67,10 @@ FabricFields::FabricFields(std::string name, int ply_a, int ply_b, const fem::Ex
   }
   centre_ = 0.5 * (lo[0] + hi[0]) * e1 + 0.5 * (lo[1] + hi[1]) * e2;
   const double tol = 0.5 * longest;
-  const double mids[4][2] = {{hi[0], 0.5 * (lo[1] + hi[1])}, {0.5 * (lo[0] + hi[0]), hi[1]},
-                             {lo[0], 0.5 * (lo[1] + hi[1])}, {0.5 * (lo[0] + hi[0]), lo[1]}};
+  const double mids[4][2] = {{hi[0], 0.5 * (lo[1] + hi[1])},
+                             {0.5 * (lo[0] + hi[0]), hi[1]},
+                             {lo[0], 0.5 * (lo[1] + hi[1])},
+                             {0.5 * (lo[0] + hi[0]), lo[1]}};
   const double corners[4][2] = {{hi[0], hi[1]}, {lo[0], hi[1]}, {lo[0], lo[1]}, {hi[0], lo[1]}};
   double best_mid[4], best_corner[4];
   std::fill(best_mid, best_mid + 4, 1e300);
@@ -127,7 +131,8 @@ void wrinkle_angles(const std::vector<V3>& centroid, const std::vector<V3>& norm
   std::vector<double> lo(3 * ply.size()), hi(3 * ply.size());
   for (std::size_t k = 0; k < ply.size(); ++k) {
     const auto c = centroid[static_cast<std::size_t>(ply[k])].arr();
-    for (std::size_t d = 0; d < 3; ++d) lo[3 * k + d] = c[d] - radius, hi[3 * k + d] = c[d] + radius;
+    for (std::size_t d = 0; d < 3; ++d)
+      lo[3 * k + d] = c[d] - radius, hi[3 * k + d] = c[d] + radius;
   }
   fem::BucketGrid grid;
   grid.build(ply.size(), lo.data(), hi.data());
@@ -160,7 +165,8 @@ FabricFields::Values FabricFields::values(const fem::ExplicitSolver& s) const {
     const auto& [k, e] = elements_[i];
     const auto& blk = s.blocks<fem::Hex8Block>()[k];
     if (blk.n_eroded && blk.eroded[e]) continue;
-    for (auto node : conn_[i]) centroid[i] += 0.125 * V3::at(X.data() + 3 * static_cast<std::size_t>(node));
+    for (auto node : conn_[i])
+      centroid[i] += 0.125 * V3::at(X.data() + 3 * static_cast<std::size_t>(node));
     const MidQuad mid(conn_[i], X.data());
     normal[i] = normalized(cross(mid.d_r(0), mid.d_t(0)));
     double d[3];
@@ -194,11 +200,13 @@ FabricFields::Values FabricFields::values(const fem::ExplicitSolver& s) const {
 
 void FabricFields::add_frame_fields(const fem::ExplicitSolver& s,
                                     std::vector<fem::MeasureCellField>& fields) const {
-  const std::size_t n_cells = s.n_elements(fem::ElementKind::Hex8) + s.n_elements(fem::ElementKind::Bar2);
+  const std::size_t n_cells =
+      s.n_elements(fem::ElementKind::Hex8) + s.n_elements(fem::ElementKind::Bar2);
   auto field = [&](const char* name) -> std::vector<double>& {
     for (auto& f : fields)
       if (f.name == name) return f.values;
-    fields.push_back({name, 1, std::vector<double>(n_cells, std::numeric_limits<double>::quiet_NaN())});
+    fields.push_back(
+        {name, 1, std::vector<double>(n_cells, std::numeric_limits<double>::quiet_NaN())});
     return fields.back().values;
   };
   const Values v = values(s);
@@ -234,7 +242,8 @@ void FabricFields::add_summary(const fem::ExplicitSolver& s, nlohmann::json& sum
   };
   double most = -1e300, mid = 0, corner = 0;
   for (auto nd : outline_) most = std::max(most, draw_in(nd));
-  for (std::size_t k = 0; k < 4; ++k) mid += 0.25 * draw_in(mid_edge_[k]), corner += 0.25 * draw_in(corner_[k]);
+  for (std::size_t k = 0; k < 4; ++k)
+    mid += 0.25 * draw_in(mid_edge_[k]), corner += 0.25 * draw_in(corner_[k]);
   summary["fabrics"][name_]["draw_in_max_m"] = fem::json_number(most);
   summary["fabrics"][name_]["draw_in_mid_edge_m"] = fem::json_number(mid);
   summary["fabrics"][name_]["draw_in_corner_m"] = fem::json_number(corner);

@@ -33,7 +33,8 @@ class FabricFields final : public fem::RunMeasure {
  public:
   /// The fabric `name` whose plies are the parts ply_a, ply_b (hexahedra).
   FabricFields(std::string name, int ply_a, int ply_b, const fem::ExplicitSolver& s);
-  void add_frame_fields(const fem::ExplicitSolver& s, std::vector<fem::MeasureCellField>& fields) const override;
+  void add_frame_fields(const fem::ExplicitSolver& s,
+                        std::vector<fem::MeasureCellField>& fields) const override;
   void add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const override;
 
   struct Values {
@@ -44,7 +45,7 @@ class FabricFields final : public fem::RunMeasure {
  private:
   std::string name_;
   std::vector<std::pair<std::size_t, std::size_t>> elements_;  // (hex block, element), ply a then b
-  std::vector<std::size_t> cell_;                               // results-file cell index of each
+  std::vector<std::size_t> cell_;                              // results-file cell index of each
   std::size_t n_a_ = 0;
   std::vector<std::array<std::int32_t, 8>> conn_;
   double reach_ = 0;

@@ -2,10 +2,10 @@
 // the last rebuild must give the same forces as testing every contact node, cycle by cycle, to
 // the last bit (the cull only skips nodes whose force is zero), while a cloud of nodes swirls
 // through a moving sphere and a plate with a hole; and the cull must actually skip nodes.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "fem/rigid_tool.hpp"
 
@@ -76,7 +76,8 @@ TEST(RigidToolCull, SameForcesAsTestingEveryNode) {
     Cloud c = make_cloud(41);
     const std::size_t n = c.x.size() / 3;
     RigidTool culled = sphere ? rising_sphere() : holed_plate();
-    for (std::size_t k = 0; k < n; ++k) culled.contact_nodes.push_back(static_cast<std::int32_t>(k));
+    for (std::size_t k = 0; k < n; ++k)
+      culled.contact_nodes.push_back(static_cast<std::int32_t>(k));
     culled.search_margin = 1e-3;
     RigidTool full = culled;
     full.search_margin = 1.0;  // every node always near: the uncull reference

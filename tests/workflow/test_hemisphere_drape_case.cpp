@@ -20,14 +20,25 @@ const fs::path kCase = kSource / "cases/hemisphere/drape.toml";
 
 // The CI mesh of the case banner.
 std::vector<std::string> ci_mesh_run(const fs::path& out) {
-  return {"-q", "run", kCase.string(), "-o", out.string(),
-          "--set", "mesh.fabric[0].elements_across_tow=1",
-          "--set", "mesh.fabric[0].element_length=6.64e-3",
-          "--set", "mesh.fabric[0].size=[0.24,0.24]",
-          "--set", "mesh.fabric[0].origin=[-0.12,-0.12,0.0]",
-          "--set", "time.mass_scaling_dt=8e-7",
-          "--set", "output.figures=false",
-          "--set", "output.report=false"};
+  return {"-q",
+          "run",
+          kCase.string(),
+          "-o",
+          out.string(),
+          "--set",
+          "mesh.fabric[0].elements_across_tow=1",
+          "--set",
+          "mesh.fabric[0].element_length=6.64e-3",
+          "--set",
+          "mesh.fabric[0].size=[0.24,0.24]",
+          "--set",
+          "mesh.fabric[0].origin=[-0.12,-0.12,0.0]",
+          "--set",
+          "time.mass_scaling_dt=8e-7",
+          "--set",
+          "output.figures=false",
+          "--set",
+          "output.report=false"};
 }
 
 TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
@@ -70,7 +81,8 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   // No ringing: over the forming (punch past 20 mm) the force departs from its 2 ms running mean
   // by under 10 % of the force at full depth.
   const auto h = read_history(out / "history.csv");
-  const auto t = h.column("time"), f = h.column("punch_force_N"), d = h.column("punch_displacement_m");
+  const auto t = h.column("time"), f = h.column("punch_force_N"),
+             d = h.column("punch_displacement_m");
   const double f_end = h.rows.back()[f];
   EXPECT_GT(f_end, 20.0);
   double worst = 0;
