@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 #include "drape/probes/fabric_fields.hpp"
 #include "drape/probes/ring_shear_probe.hpp"
@@ -115,6 +116,27 @@ TEST(RingShearProbe, OnlyOneRingAndTwoPlies) {
   fs::remove(file);
 }
 
+
+namespace {
+
+// The flat +-45 blanket of kCase with its solver and its fabric fields (the solver borrows the
+// case's model: the case lives as long as it).
+struct FlatBlanketFields {
+  fs::path file;
+  workflow::EngineCase ec;
+  std::unique_ptr<fem::ExplicitSolver> solver;
+  std::unique_ptr<drape::FabricFields> fields;
+  explicit FlatBlanketFields(const std::string& name)
+      : file(write_case(kCase, name)), ec(workflow::load_engine_case(file, {})) {
+    const auto& f = ec.fabric_summaries.at(0);
+    solver = std::make_unique<fem::ExplicitSolver>(ec.model);
+    fields = std::make_unique<drape::FabricFields>(f.name, f.ply_parts.at(0), f.ply_parts.at(1), *solver);
+  }
+  ~FlatBlanketFields() { fs::remove(file); }
+};
+
+}  // namespace
+
 // The fabric's element fields (drape/probes/fabric_fields.hpp) on the flat +-45 blanket: none
 // undeformed; under an in-plane simple shear x' = x + k y of both plies, every element reads the
 // angle the mapped fibres (1, 1) and (1, -1) make, 90 - acos(|Fa.Fb| / |Fa||Fb|), and no slip;
@@ -186,11 +208,9 @@ TEST(FabricFields, ShearAngleAndSlipOfAnAffineDeformation) {
 // about the blank's centre (30, 30) mm brings each outline node nearer by c times its distance:
 // the 30 mm to the edge mid-points, 42.4 mm to the corners.
 TEST(FabricFields, DrawInOfTheOutline) {
-  const fs::path file = write_case(kCase, "fields_drawin");
-  auto ec = workflow::load_engine_case(file, {});
-  const auto& f = ec.fabric_summaries.at(0);
-  fem::ExplicitSolver solver(ec.model);
-  const drape::FabricFields m(f.name, f.ply_parts[0], f.ply_parts[1], solver);
+  FlatBlanketFields b("fields_drawin");
+  fem::ExplicitSolver& solver = *b.solver;
+  const drape::FabricFields& m = *b.fields;
   nlohmann::json s;
   m.add_summary(solver, s);
   EXPECT_NEAR(s["fabrics"]["ncf"]["draw_in_max_m"].get<double>(), 0.0, 1e-15);
@@ -205,18 +225,15 @@ TEST(FabricFields, DrawInOfTheOutline) {
   EXPECT_NEAR(fab["draw_in_mid_edge_m"].get<double>(), c * 0.03, 0.05 * c * 0.03);
   EXPECT_NEAR(fab["draw_in_corner_m"].get<double>(), c * 0.03 * std::sqrt(2.0), 0.05 * c * 0.03);
   EXPECT_NEAR(fab["draw_in_max_m"].get<double>(), c * 0.03 * std::sqrt(2.0), 0.05 * c * 0.03);
-  fs::remove(file);
 }
 
 // Wrinkle indicator: none on the flat blanket; a wave z = A sin(2 pi x / L) shorter than the
 // neighbourhood (L = 20 mm, A = 1 mm: largest slope 2 pi A / L, 17.4 deg) reads close to its
 // slope where it is steepest (the elements' normals average the slope over their length).
 TEST(FabricFields, WrinkleAngleReadsTheSlopeOfAShortWave) {
-  const fs::path file = write_case(kCase, "fields_wrinkle");
-  auto ec = workflow::load_engine_case(file, {});
-  const auto& f = ec.fabric_summaries.at(0);
-  fem::ExplicitSolver solver(ec.model);
-  const drape::FabricFields m(f.name, f.ply_parts[0], f.ply_parts[1], solver);
+  FlatBlanketFields b("fields_wrinkle");
+  fem::ExplicitSolver& solver = *b.solver;
+  const drape::FabricFields& m = *b.fields;
   for (double w : m.values(solver).wrinkle_deg) EXPECT_NEAR(w, 0.0, 1e-6);
   const double A = 1e-3, L = 0.02;
   {
@@ -228,5 +245,4 @@ TEST(FabricFields, WrinkleAngleReadsTheSlopeOfAShortWave) {
   for (double w : m.values(solver).wrinkle_deg) most = std::max(most, w);
   EXPECT_GT(most, 0.6 * slope_deg);
   EXPECT_LT(most, 1.2 * slope_deg);
-  fs::remove(file);
 }
