@@ -86,6 +86,9 @@ ImpregnatedMapping map_impregnated(const DrapedTows& t, const MappingSpec& spec)
     if (vf > spec.vf_locking) {
       vf = spec.vf_locking;
       ++m.n_capped;
+    } else if (vf < spec.vf_undeformed) {
+      vf = spec.vf_undeformed;
+      ++m.n_floored;
     }
     m.vf[e] = vf;
     const long bin = std::lround(vf / spec.vf_bin);

@@ -6,7 +6,8 @@
 //    axis 2 = 3 x 1 (right-handed);
 //  * its fibre volume fraction raised by its compaction during the drape: Vf = Vf0 lambda_1 / J
 //    (constant fibre content, J the volume ratio of the hexahedron, lambda_1 the fibre stretch),
-//    capped at the locking value;
+//    capped at the locking value and floored at the undeformed one (a tow the drape spread, with
+//    J / lambda_1 > 1, is pressed back to at least its nominal Vf by the infusion's vacuum bag);
 //  * a material class: elements are grouped by Vf into bins of `vf_bin` width, one impregnated
 //    material per bin, so that the crush runs over batches of one material (bins of 0.005 keep
 //    the moduli within ~1 % of the element's own).
@@ -41,6 +42,7 @@ struct ImpregnatedMapping {
   std::vector<std::int32_t> vf_class;        // per element: index into class_vf
   std::vector<double> class_vf;              // Vf of each class (its bin centre)
   std::size_t n_capped = 0;                  // elements whose Vf was capped at the locking value
+  std::size_t n_floored = 0;                 // elements whose Vf was raised to the undeformed value
 };
 
 /// Exact volume of a trilinear hexahedron (2 x 2 x 2 Gauss points integrate its Jacobian exactly).

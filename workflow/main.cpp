@@ -18,6 +18,7 @@
 #include "workflow/report/report.hpp"
 #include "workflow/run/engine_run.hpp"
 #include "workflow/stages/stage_registry.hpp"
+#include "workflow/stages/transfer_export.hpp"
 #include "workflow/version.hpp"
 
 namespace wf = ncfsim::workflow;
@@ -75,6 +76,13 @@ int main(int argc, char** argv) {
   render->add_option("outdir", folder, "Output folder of a run")->required();
   auto* report = app.add_subcommand("report", "Write report.html for a finished run");
   report->add_option("outdir", folder, "Output folder of a run")->required();
+  std::string deck_format;
+  auto* exporter = app.add_subcommand(
+      "export", "Write the impregnated model of a transfer run as an Abaqus or LS-DYNA deck");
+  exporter->add_option("outdir", folder, "Output folder of a transfer run")->required();
+  exporter->add_option("--format", deck_format, "abaqus | lsdyna")
+      ->required()
+      ->check(CLI::IsMember({"abaqus", "lsdyna"}));
 
   wf::StitchCalibrationOptions sc;
   std::string shear = "positive";
@@ -190,6 +198,13 @@ int main(int argc, char** argv) {
       const auto pngs = wf::render_figures(folder, *log);
       for (const auto& p : pngs) log->info("{}", p.string());
       return pngs.empty() ? wf::kOtherError : wf::kSuccess;
+    }
+    if (*exporter) {
+      require_output_folder(folder);
+      const auto r = wf::export_impregnated(folder, deck_format);
+      std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs\n", r.file.c_str(), r.nodes,
+                  r.elements, r.materials, r.tie_pairs);
+      return wf::kSuccess;
     }
     if (*report) {
       require_output_folder(folder);

@@ -186,7 +186,7 @@ TEST(CaseReading, BlankholderPressureGivesTheForceOverTheCoveredArea) {
   const auto ec = workflow::load_engine_case(file, ci);
   const auto& bh = ec.model.tools.at(1);
   ASSERT_EQ(bh.name, "blankholder");
-  const double area = 0.24 * 0.24 - M_PI * 0.096 * 0.096;  // the 96 mm blankholder hole
+  const double area = 0.24 * 0.24 - M_PI * 0.100 * 0.100;  // the 100 mm blankholder hole
   EXPECT_NEAR(bh.motion.pressed_area, area, 1e-9 * area);
   EXPECT_NEAR(bh.motion.force, 3350.0 * area, 1e-9 * 3350.0 * area);
   auto expect_key = [&](std::vector<std::string> extra, const std::string& key) {

@@ -86,6 +86,19 @@ TEST(Impregnation, CompactedTowGainsFibreVolumeFractionAndIsCappedAtLocking) {
   EXPECT_NEAR(m.class_vf[static_cast<std::size_t>(m.vf_class[0])], 0.6 / 0.9, spec.vf_bin / 2);
   EXPECT_DOUBLE_EQ(m.vf[1], spec.vf_locking);
   EXPECT_EQ(m.n_capped, 1u);
+  EXPECT_EQ(m.n_floored, 0u);
+}
+
+// A tow the drape spread (cross-section to 125 %) keeps its nominal Vf: the infusion's vacuum bag
+// presses it back; counted.
+TEST(Impregnation, SpreadTowKeepsItsNominalFibreVolumeFraction) {
+  auto t = boxes({0.0, 0.0});
+  for (std::size_t i = 0; i < 8; ++i) t.current[i].y *= 1.25;
+  transfer::MappingSpec spec;
+  const auto m = transfer::map_impregnated(t, spec);
+  EXPECT_NEAR(m.volume_ratio[0], 1.25, 1e-12);
+  EXPECT_DOUBLE_EQ(m.vf[0], spec.vf_undeformed);
+  EXPECT_EQ(m.n_floored, 1u);
 }
 
 TEST(Impregnation, TrilinearVolumeIsExact) {

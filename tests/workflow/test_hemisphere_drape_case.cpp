@@ -5,7 +5,8 @@
 // equator at the blankholder plane), the energy balance stays under 2 %, kinetic / internal under
 // 10 % over the forming, no tow passes through another or through a tool, the blankholder presses
 // with 3.35 kPa over the blank it covers, the ring measure is written with its four quadrant
-// maxima, and the punch force rises without ringing. Bad input names the key.
+// maxima, and the punch force rises without ringing; the formed part transfers to the impregnated
+// model (issue #20). Bad input names the key.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -51,8 +52,8 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   EXPECT_GE(s["punch_displacement_m"].get<double>(), 0.081);
   EXPECT_LT(s["energy_balance_error_max"].get<double>(), 0.02);
   EXPECT_LT(s["kinetic_to_internal_max"].get<double>(), 0.10);
-  // 3.35 kPa over the 240 mm square less the blankholder's 96 mm hole.
-  const double area = 0.24 * 0.24 - M_PI * 0.096 * 0.096;
+  // 3.35 kPa over the 240 mm square less the blankholder's 100 mm hole.
+  const double area = 0.24 * 0.24 - M_PI * 0.100 * 0.100;
   EXPECT_NEAR(s["blankholder_pressed_area_m2"].get<double>(), area, 1e-3 * area);
   EXPECT_NEAR(s["blankholder_applied_force_N"].get<double>(), 3350.0 * area, 1e-3 * 3350.0 * area);
   // No tow through a tool or through another: the deepest penetration over the run stays a small
@@ -95,6 +96,21 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
     worst = std::max(worst, std::abs(h.rows[k][f] - sum / n));
   }
   EXPECT_LT(worst, 0.10 * f_end) << "punch force rings";
+
+  // The transfer of the formed part (issue #20): no element lost, Vf between the undeformed and
+  // the locking value, the plies and tows tied.
+  const fs::path tr = out / "transfer";
+  const auto tr_run = run_cli({"-q", "run", (kSource / "cases/hemisphere/transfer.toml").string(), "-o", tr.string(),
+                          "--set", "source.results=" + (out / "results.h5").string()});
+  ASSERT_EQ(tr_run.code, 0) << tr_run.output;
+  const auto ts = nlohmann::json::parse(slurp(tr / "summary.json"));
+  EXPECT_EQ(ts["elements_mapped"], s["elements"]["hex8"]);
+  EXPECT_EQ(ts["elements_lost"], 0);
+  EXPECT_GE(ts["vf_min"].get<double>(), 0.6 - 1e-12);
+  EXPECT_LE(ts["vf_max"].get<double>(), 0.857 + 1e-12);
+  EXPECT_GT(ts["vf_max"].get<double>(), 0.65) << "the flange's compaction shows";
+  EXPECT_GT(ts["tie_pairs_interply"].get<std::size_t>(), s["elements"]["hex8"].get<std::size_t>() / 4);
+  EXPECT_GT(ts["tie_pairs_intraply"].get<std::size_t>(), 0u);
   fs::remove_all(out);
 }
 

@@ -9,6 +9,7 @@
 #include "fem/solver.hpp"
 #include "workflow/run/run_summary.hpp"
 #include "workflow/stages/kinematic_drape_stage.hpp"
+#include "workflow/stages/transfer_stage.hpp"
 
 namespace ncfsim::workflow {
 
@@ -64,12 +65,15 @@ const std::vector<Stage>& stages() {
       {"kinematic_drape",
        "pin-jointed net (fishnet) drape on rigid tool surfaces, ring shear measure",
        &run_kinematic_drape_stage, &check_kinematic_drape_stage},
+      {"transfer",
+       "draped tows to the impregnated composite model (micromechanics, Vf from compaction, ties)",
+       &run_transfer_stage, &check_transfer_stage},
   };
   return registry;
 }
 
 const std::vector<std::string>& planned_stage_kinds() {
-  static const std::vector<std::string> planned{"transfer", "crush", "workflow"};
+  static const std::vector<std::string> planned{"crush", "workflow"};
   return planned;
 }
 

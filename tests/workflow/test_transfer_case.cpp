@@ -1,0 +1,165 @@
+// The transfer stage end to end (issue #20): a flat +-45 blanket is run for a few cycles (nearly
+// undeformed), then `ncfsim run` of a kind = "transfer" case maps it: every tow hexahedron, Vf at
+// its undeformed value, fibre directions at +-45 deg in orthonormal frames, plies tied face to face
+// and tows to their neighbours; `ncfsim export` writes Abaqus and LS-DYNA decks that read back with
+// the same counts; bad input names the key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "fem/io/stage_handoff.hpp"
+#include "tests/workflow/cli_test_support.hpp"
+#include "transfer/deck_export.hpp"
+
+namespace ncfsim::test {
+namespace {
+
+const char* kBlanket = R"(
+[case]
+name = "flat_blanket"
+[mesh]
+[[mesh.fabric]]
+name = "ncf"
+origin = [0.0, 0.0, 0.0]
+size = [0.06, 0.06]
+ply_angles_deg = [45.0, -45.0]
+elements_across_tow = 1
+element_length = 6.64e-3
+tow_material = "dry_tow"
+stitch_law_I = "stitch"
+stitch_law_Lambda = "stitch"
+[[material]]
+name = "dry_tow"
+type = "tow_biphase"
+density = 1080.0
+E11f = 0.07e9
+E11m = 1.0e6
+E22m = 0.5e6
+E33m = 0.5e6
+G12m = 0.1e6
+compaction_modulus = 2.0e6
+[[bar_law]]
+name = "stitch"
+type = "tabulated"
+tension_only = true
+linear_density = 7.6e-6
+strain = [0.0, 0.1]
+force = [0.0, 2.0]
+[time]
+end_time = 2e-6
+[output]
+figures = false
+)";
+
+const char* kTransfer = R"(
+[case]
+name = "flat_transfer"
+kind = "transfer"
+[source]
+results = "drape/results.h5"
+[trim]
+radius = 0.0
+centre = [0.03, 0.03, 0.0]
+)";
+
+struct Fixture {
+  fs::path dir = fresh_dir("transfer_case");
+  fs::path drape_case = dir / "blanket.toml", transfer_case = dir / "transfer.toml";
+  Fixture() {
+    fs::create_directories(dir);
+    std::ofstream(drape_case) << kBlanket;
+    std::ofstream(transfer_case) << kTransfer;
+    const auto r = run_cli({"-q", "run", drape_case.string(), "-o", (dir / "drape").string()});
+    EXPECT_EQ(r.code, 0) << r.output;
+  }
+  ~Fixture() { fs::remove_all(dir); }
+};
+
+TEST(CliTransfer, FlatBlanketMapsEveryTowWithItsFrameVfAndTies) {
+  Fixture f;
+  const fs::path out = f.dir / "transfer";
+  const auto r = run_cli({"run", f.transfer_case.string(), "-o", out.string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+  const auto drape = nlohmann::json::parse(slurp(f.dir / "drape" / "summary.json"));
+  const std::size_t hexes = drape["elements"]["hex8"];
+  EXPECT_EQ(s["stage"], "transfer");
+  EXPECT_EQ(s["elements_mapped"].get<std::size_t>(), hexes);
+  EXPECT_EQ(s["elements_lost"], 0);
+  EXPECT_NEAR(s["vf_min"].get<double>(), 0.6, 1e-3);
+  EXPECT_NEAR(s["vf_max"].get<double>(), 0.6, 1e-3);
+  // Every ply-1 tow lies on ply 2 (its top faces tied, less the tow ends at the blanket's edge),
+  // and each tow beside its neighbours.
+  EXPECT_GT(s["tie_pairs_interply"].get<std::size_t>(), hexes / 2 * 8 / 10);
+  EXPECT_GT(s["tie_pairs_intraply"].get<std::size_t>(), hexes / 4);
+  EXPECT_EQ(s["stitches_kept"], 0);
+  // Frames: orthonormal, axis 1 at +-45 deg in the plane, axis 3 through the thickness (z).
+  const auto frame = fem::io::read_last_frame(out / "results.h5");
+  const auto* a1 = frame.field("fibre_direction");
+  const auto* a2 = frame.field("material_axis_2");
+  const auto* a3 = frame.field("material_axis_3");
+  ASSERT_TRUE(a1 && a2 && a3);
+  for (std::size_t e = 0; e < hexes; ++e) {
+    const double* u = &a1->values[3 * e];
+    const double* v = &a2->values[3 * e];
+    const double* w = &a3->values[3 * e];
+    auto dotp = [](const double* p, const double* q) {
+      return p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    };
+    ASSERT_NEAR(dotp(u, u), 1.0, 1e-9);
+    ASSERT_NEAR(dotp(v, v), 1.0, 1e-9);
+    ASSERT_NEAR(dotp(u, v), 0.0, 1e-9);
+    ASSERT_NEAR(dotp(u, w), 0.0, 1e-9);
+    EXPECT_NEAR(std::abs(u[0]), std::sqrt(0.5), 1e-3) << e;
+    EXPECT_NEAR(std::abs(u[1]), std::sqrt(0.5), 1e-3) << e;
+    EXPECT_NEAR(std::abs(w[2]), 1.0, 1e-6) << e;
+  }
+  EXPECT_TRUE(fs::exists(out / "materials.csv"));
+  EXPECT_TRUE(fs::exists(out / "vf_histogram.csv"));
+
+  // Decks that read back with the model's counts.
+  for (const std::string format : {"abaqus", "lsdyna"}) {
+    const auto e = run_cli({"export", out.string(), "--format", format});
+    ASSERT_EQ(e.code, 0) << e.output;
+    const auto deck = transfer::read_deck(
+        out / (format == "abaqus" ? "impregnated.inp" : "impregnated.k"), format);
+    EXPECT_EQ(deck.elements, hexes) << format;
+    EXPECT_EQ(deck.nodes, frame.n_points()) << format;
+    EXPECT_EQ(deck.materials, s["material_classes"].get<std::size_t>()) << format;
+    EXPECT_EQ(deck.ties, 2u) << format;  // the interply and intraply interfaces
+  }
+  EXPECT_EQ(run_cli({"export", (f.dir / "drape").string(), "--format", "abaqus"}).code, 2)
+      << "a drape run is not a transfer run";
+}
+
+TEST(CliTransfer, BadInputNamesTheKey) {
+  Fixture f;
+  const struct {
+    std::vector<std::string> sets;
+    std::string key;
+  } bad[] = {
+      {{"source.results=nowhere/results.h5"}, "source.results"},
+      {{"fibre.E1=0.0"}, "fibre.E1"},
+      {{"impregnation.vf_undeformed=0.95"}, "impregnation.vf_undeformed"},
+      {{"trim.radius=1e-4"}, "trim.radius"},
+  };
+  for (const auto& b : bad) {
+    std::vector<std::string> args{"run", f.transfer_case.string(), "-o", (f.dir / "bad").string()};
+    for (const auto& s : b.sets) args.insert(args.end(), {"--set", s});
+    const auto r = run_cli(args);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find(b.key), std::string::npos) << r.output;
+  }
+  // An unfinished drape run (its summary says so) is refused.
+  const fs::path summary = f.dir / "drape" / "summary.json";
+  auto s = nlohmann::json::parse(slurp(summary));
+  s["status"] = "interrupted";
+  std::ofstream(summary) << s.dump();
+  const auto r = run_cli({"run", f.transfer_case.string(), "-o", (f.dir / "bad").string()});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("did not complete"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace ncfsim::test

@@ -1,0 +1,83 @@
+#pragma once
+// The impregnated composite model of a formed part, built from a drape result's frame (issue #20):
+// the draped tow hexahedra, in their draped shape (the new stress-free reference), each with its
+// material frame, its fibre volume fraction raised by its compaction during the drape, its
+// impregnated-tow properties (micromechanics at that Vf, in Vf classes), trimmed at a radius, and
+// the tied pairs of faces the resin bonds: between plies (delamination) and between tows of a ply
+// (intra-ply debond). Plain data; the transfer stage (workflow/stages) writes it, the crush reads
+// it back through the stage hand-off, `ncfsim export` turns it into an Abaqus or LS-DYNA deck.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fem/io/stage_handoff.hpp"
+#include "fem/vec3.hpp"
+#include "transfer/deck_export.hpp"
+#include "transfer/impregnation.hpp"
+#include "transfer/micromechanics.hpp"
+
+namespace ncfsim::transfer {
+
+struct TrimSpec {
+  double radius = 0;  // m; 0: keep the whole part
+  fem::V3 centre{};   // a point of the part's axis
+  fem::V3 axis{0, 0, 1};
+};
+
+struct TieSpec {
+  bool interply = true;  // faces of one ply on faces of the other
+  bool intraply = true;  // side faces of neighbouring tows of a ply
+  double distance =
+      0;  // m, the most resin between two bonded faces (0: the thinnest tow's thickness)
+  double normal_strength = 0, shear_strength = 0;  // Pa, the resin's bond (0: the resin's own)
+};
+
+struct TransferSpec {
+  std::vector<int> parts;  // part ids of the tow hexahedra to take (empty: every tow hexahedron)
+  FibreData fibre;
+  ResinData resin;
+  double compressive_ratio = 0.6;
+  MappingSpec mapping;
+  TrimSpec trim;
+  TieSpec ties;
+};
+
+/// The tied face pairs of one interface: faces as (element, face 0..5, VTK hexahedron faces -z,
+/// +z, -y, +x, +y, -x of the reference cube), slave and master sides pair by pair.
+struct TiePairs {
+  std::string name;  // "interply" or "intraply"
+  std::vector<std::pair<std::int32_t, int>> slave, master;
+};
+
+struct ImpregnatedModel {
+  std::vector<double> points;                    // [3 n] the draped positions
+  std::vector<std::int64_t> point_user_id;       // per point (the drape's node ids)
+  std::vector<std::array<std::int32_t, 8>> hex;  // into points, VTK order
+  std::vector<std::int64_t> hex_user_id;         // the drape's hexahedron ids
+  std::vector<std::int32_t> hex_part, hex_ply, hex_tow;
+  std::vector<std::string> part_names;
+  std::vector<std::array<double, 9>> frame;  // per element: row-major, axes as columns
+  std::vector<double> vf, volume_ratio;      // per element
+  std::vector<std::int32_t> vf_class;        // per element, into classes
+  std::vector<ImpregnatedTow> classes;       // one impregnated tow per Vf class
+  std::vector<TiePairs> ties;
+  std::size_t n_candidates = 0;  // tow hexahedra in the source frame (selected parts)
+  std::size_t n_trimmed = 0;     // left out by the trim
+  std::size_t n_lost = 0;      // not mappable (a non-positive volume, a fibre along the thickness)
+  std::size_t n_capped = 0;    // Vf capped at the locking value
+  std::size_t n_floored = 0;   // Vf raised to the undeformed value (a tow the drape spread)
+  std::size_t n_stitches = 0;  // stitch bars in the source frame (dropped)
+
+  std::size_t n_elements() const { return hex.size(); }
+  std::size_t n_tie_pairs() const;
+  /// The model as a deck for `ncfsim export` (one material per Vf class).
+  ExportModel export_model() const;
+};
+
+/// Throws std::invalid_argument naming the spec's field for a bad spec, std::runtime_error when the
+/// frame holds no tow hexahedra or no fibre_direction field.
+ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
+                                         const TransferSpec& spec);
+
+}  // namespace ncfsim::transfer
