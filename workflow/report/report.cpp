@@ -70,12 +70,12 @@ void write_report(const std::filesystem::path& dir) {
   const double lim = summary_number(s, "energy_balance_limit", 0.05);
   h << "<p>ncfsim " << escape(s.value("ncfsim_version", "?")) << " &middot; stage "
     << escape(s.value("stage", "?")) << " &middot; status <span class=\""
-    << (status == "completed" ? "ok" : "bad") << "\">" << escape(status)
-    << "</span> &middot; energy balance error <span class=\"" << (err <= lim ? "ok" : "bad")
-    << "\">"
-    << (std::isfinite(err) ? escape(nlohmann::json(100 * err).dump()) + " %"
-                           : std::string("not finite"))
-    << "</span> (limit " << 100 * lim << " %)</p>\n";
+    << (status == "completed" ? "ok" : "bad") << "\">" << escape(status) << "</span>";
+  if (s.contains("energy_balance_error"))  // explicit runs; a transfer has no time loop
+    h << " &middot; energy balance error <span class=\"" << (err <= lim ? "ok" : "bad") << "\">"
+      << (std::isfinite(err) ? escape(nlohmann::json(100 * err).dump()) + " %" : std::string("not finite"))
+      << "</span> (limit " << 100 * lim << " %)";
+  h << "</p>\n";
   if (s.contains("error")) h << "<p class=\"bad\">" << escape(s["error"].get<std::string>()) << "</p>\n";
 
   std::vector<std::filesystem::path> figs;

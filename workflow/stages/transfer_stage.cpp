@@ -13,6 +13,7 @@
 #include "fem/io/stage_handoff.hpp"
 #include "transfer/case/transfer_case.hpp"
 #include "workflow/figures/figures.hpp"
+#include "workflow/report/report.hpp"
 #include "workflow/output/output_files.hpp"
 #include "workflow/version.hpp"
 
@@ -267,6 +268,11 @@ int run_transfer_stage(const StageCall& call) {
   s["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_file_atomically(dir / "summary.json", s.dump(2) + "\n");
   if (tc.figures && tc.frames_xdmf) write_figures(dir, tc.name, *log);
+  try {
+    write_report(dir);
+  } catch (const std::exception& e) {
+    log->warn("report not written: {}", e.what());
+  }
   log->info("results in {}", dir.string());
   return kSuccess;
 }
