@@ -59,7 +59,7 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   // No tow through a tool or through another: the deepest penetration over the run stays a small
   // share of a tow's thickness (0.23 mm).
   const double tow = s["fabrics"]["ncf"]["tow_thickness_m"];
-  for (const char* tool : {"punch", "blankholder", "die", "die_fillet"})
+  for (const char* tool : {"punch", "blankholder", "blankholder_edge", "die", "die_fillet"})
     EXPECT_LT(s[std::string(tool) + "_max_penetration_m"].get<double>(), 0.25 * tow) << tool;
   EXPECT_LT(s["fabric_max_penetration_m"].get<double>(), 0.5 * tow);
   EXPECT_EQ(s["eroded_elements"], 0);
