@@ -61,7 +61,9 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   const double tow = s["fabrics"]["ncf"]["tow_thickness_m"];
   for (const char* tool : {"punch", "blankholder", "blankholder_edge", "die", "die_fillet"})
     EXPECT_LT(s[std::string(tool) + "_max_penetration_m"].get<double>(), 0.25 * tow) << tool;
-  EXPECT_LT(s["fabric_max_penetration_m"].get<double>(), 0.5 * tow);
+  // Tow on tow: no node ever deeper than a tow's thickness (the contact holds a node to half the
+  // facet's thickness on the plies' faces, more on the tows' sides).
+  EXPECT_LT(s["fabric_max_penetration_m"].get<double>(), tow);
   EXPECT_EQ(s["eroded_elements"], 0);
   // The ring measure: four quadrant maxima, every azimuth on the formed fabric.
   for (int q = 1; q <= 4; ++q) {
