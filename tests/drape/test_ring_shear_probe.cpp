@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "drape/probes/fabric_fields.hpp"
+#include "tests/flat_blanket_case.hpp"
 #include "drape/probes/ring_shear_probe.hpp"
 #include "fem/elements/hex8_block.hpp"
 #include "fem/errors.hpp"
@@ -21,37 +22,7 @@ using namespace ncfsim;
 
 namespace {
 
-const char* kCase = R"(
-[case]
-name = "ring_flat"
-[mesh]
-[[mesh.fabric]]
-name = "ncf"
-origin = [0.0, 0.0, 0.0]
-size = [0.06, 0.06]
-ply_angles_deg = [45.0, -45.0]
-elements_across_tow = 1
-element_length = 6.64e-3
-tow_material = "dry_tow"
-stitch_law_I = "stitch"
-stitch_law_Lambda = "stitch"
-[[material]]
-name = "dry_tow"
-type = "tow_biphase"
-density = 1080.0
-E11f = 0.07e9
-E11m = 1.0e6
-E22m = 0.5e6
-E33m = 0.5e6
-G12m = 0.1e6
-compaction_modulus = 2.0e6
-[[bar_law]]
-name = "stitch"
-type = "tabulated"
-tension_only = true
-linear_density = 7.6e-6
-strain = [0.0, 0.1]
-force = [0.0, 2.0]
+const std::string kCase = std::string("[case]\nname = \"ring_flat\"\n") + test::kFlatBlanketBody + R"(
 [time]
 end_time = 1e-4
 [output]

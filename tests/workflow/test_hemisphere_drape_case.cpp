@@ -115,17 +115,20 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   // The transfer of the formed part (issue #20): no element lost, Vf between the undeformed and
   // the locking value, the plies and tows tied.
   const fs::path tr = out / "transfer";
-  const auto tr_run = run_cli({"-q", "run", (kSource / "cases/hemisphere/transfer.toml").string(), "-o", tr.string(),
-                          "--set", "source.results=" + (out / "results.h5").string()});
+  const auto tr_run =
+      run_cli({"-q", "run", (kSource / "cases/hemisphere/transfer.toml").string(), "-o",
+               tr.string(), "--set", "source.results=" + (out / "results.h5").string()});
   ASSERT_EQ(tr_run.code, 0) << tr_run.output;
   const auto ts = nlohmann::json::parse(slurp(tr / "summary.json"));
   // Every tow element that was not eroded (an eroded one has no shape to map).
   EXPECT_EQ(ts["elements_lost"], s["eroded_elements"]);
-  EXPECT_EQ(ts["elements_mapped"].get<std::size_t>() + ts["elements_lost"].get<std::size_t>(), hexes);
+  EXPECT_EQ(ts["elements_mapped"].get<std::size_t>() + ts["elements_lost"].get<std::size_t>(),
+            hexes);
   EXPECT_GE(ts["vf_min"].get<double>(), 0.6 - 1e-12);
   EXPECT_LE(ts["vf_max"].get<double>(), 0.857 + 1e-12);
   EXPECT_GT(ts["vf_max"].get<double>(), 0.65) << "the flange's compaction shows";
-  EXPECT_GT(ts["tie_pairs_interply"].get<std::size_t>(), s["elements"]["hex8"].get<std::size_t>() / 4);
+  EXPECT_GT(ts["tie_pairs_interply"].get<std::size_t>(),
+            s["elements"]["hex8"].get<std::size_t>() / 4);
   EXPECT_GT(ts["tie_pairs_intraply"].get<std::size_t>(), 0u);
   fs::remove_all(out);
 }

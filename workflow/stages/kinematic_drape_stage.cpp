@@ -63,13 +63,7 @@ int run_kinematic_drape_stage(const StageCall& call) {
 
   write_file_atomically(dir / "ring_shear.csv", drape::ring_csv(ring, "kinematic_shear_deg"));
   write_file_atomically(dir / "net.csv", net_csv(net));
-  nlohmann::json s;
-  s["case"] = kc.name;
-  s["case_file"] = call.case_file.string();
-  s["stage"] = "kinematic_drape";
-  s["ncfsim_version"] = kVersion;
-  s["overrides"] = call.overrides;
-  s["status"] = "completed";
+  nlohmann::json s = stage_summary_header(kc.name, call, "kinematic_drape");
   s["net_joints"] = joints;
   s["net_joints_not_placed"] = net.n_locked;
   s["net_spacing_m"] = net.spacing;

@@ -10,6 +10,7 @@
 #include "workflow/run/run_summary.hpp"
 #include "workflow/stages/kinematic_drape_stage.hpp"
 #include "workflow/stages/transfer_stage.hpp"
+#include "workflow/version.hpp"
 
 namespace ncfsim::workflow {
 
@@ -45,6 +46,18 @@ int check_kinematic_drape_stage(const StageCall& call) {
 }
 
 }  // namespace
+
+nlohmann::json stage_summary_header(const std::string& case_name, const StageCall& call,
+                                    const std::string& stage) {
+  nlohmann::json s;
+  s["case"] = case_name;
+  s["case_file"] = call.case_file.string();
+  s["stage"] = stage;
+  s["ncfsim_version"] = kVersion;
+  s["overrides"] = call.overrides;
+  s["status"] = "completed";
+  return s;
+}
 
 int refuse_many_ranks() {
   const int n = fem::PetscSession::size();

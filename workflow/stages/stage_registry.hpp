@@ -5,6 +5,7 @@
 // reader), runs into the output folder and returns the exit code of the command line; it hands the
 // next stage its results.h5 (fem/io/stage_handoff.hpp).
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,11 @@ std::string case_kind(const std::filesystem::path& file, const std::vector<std::
 int run_stage(const StageCall& call);
 /// Looks the case's kind up and checks it (`ncfsim check`).
 int check_stage(const StageCall& call);
+
+/// The keys every stage's summary.json starts with: case, case_file, stage, ncfsim_version,
+/// overrides, status ("completed").
+nlohmann::json stage_summary_header(const std::string& case_name, const StageCall& call,
+                                    const std::string& stage);
 
 /// Until the domain decomposition lands the engine runs on one MPI rank: started by mpirun on
 /// more, every rank would run the whole model and write the same files. Returns the exit code

@@ -13,8 +13,8 @@
 #include "fem/io/stage_handoff.hpp"
 #include "transfer/case/transfer_case.hpp"
 #include "workflow/figures/figures.hpp"
-#include "workflow/report/report.hpp"
 #include "workflow/output/output_files.hpp"
+#include "workflow/report/report.hpp"
 #include "workflow/version.hpp"
 
 namespace ncfsim::workflow {
@@ -239,13 +239,7 @@ int run_transfer_stage(const StageCall& call) {
   write_file_atomically(dir / "ties.csv", ties_csv(m));
   write_file_atomically(dir / "vf_histogram.csv", vf_histogram_csv(m, tc.spec.mapping));
 
-  nlohmann::json s;
-  s["case"] = tc.name;
-  s["case_file"] = call.case_file.string();
-  s["stage"] = "transfer";
-  s["ncfsim_version"] = kVersion;
-  s["overrides"] = call.overrides;
-  s["status"] = "completed";
+  nlohmann::json s = stage_summary_header(tc.name, call, "transfer");
   s["source_results"] = tc.results.string();
   s["source_frame"] = frame.index;
   s["source_time_s"] = frame.time;
