@@ -82,6 +82,8 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
   const fem::io::FrameField* fibre_field = frame.field("fibre_direction");
   if (!fibre_field || fibre_field->n_components != 3)
     throw std::runtime_error(frame.file.string() + ": the frame has no fibre_direction field");
+  // Hexahedra the drape eroded are no longer part of the fabric.
+  const fem::io::FrameField* eroded = frame.field("eroded");
   const auto& X0 = mesh.points;
   const auto& x1 = frame.coordinates;
   auto at = [](const std::vector<double>& v, std::int64_t i) {
@@ -102,6 +104,11 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
         std::find(spec.parts.begin(), spec.parts.end(), mesh.hex_part[e]) == spec.parts.end())
       continue;
     ++m.n_candidates;
+    if (eroded && eroded->n_components == 1 && eroded->values[e] > 0.5) {
+      ++m.n_lost;
+      ++m.n_eroded;
+      continue;
+    }
     std::array<V3, 8> X, x;
     V3 centre;
     for (std::size_t a = 0; a < 8; ++a) {

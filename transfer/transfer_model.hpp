@@ -64,7 +64,9 @@ struct ImpregnatedModel {
   std::vector<TiePairs> ties;
   std::size_t n_candidates = 0;  // tow hexahedra in the source frame (selected parts)
   std::size_t n_trimmed = 0;     // left out by the trim
-  std::size_t n_lost = 0;      // not mappable (a non-positive volume, a fibre along the thickness)
+  std::size_t n_lost = 0;      // not mapped: eroded in the drape, a non-positive volume, a fibre
+                               // along the thickness
+  std::size_t n_eroded = 0;    // of those, eroded in the drape
   std::size_t n_capped = 0;    // Vf capped at the locking value
   std::size_t n_floored = 0;   // Vf raised to the undeformed value (a tow the drape spread)
   std::size_t n_stitches = 0;  // stitch bars in the source frame (dropped)

@@ -230,9 +230,9 @@ int run_transfer_stage(const StageCall& call) {
       tc.spec.mapping.vf_undeformed, m.classes.size());
   for (const auto& t : m.ties) log->info("tied {}: {} face pairs", t.name, t.slave.size());
   if (m.n_lost)
-    log->warn(
-        "{} tow hexahedra could not be mapped (non-positive volume or fibre along the thickness)",
-        m.n_lost);
+    log->warn("{} tow hexahedra not mapped: {} eroded in the drape, {} with a non-positive volume or "
+              "the fibre along the thickness",
+              m.n_lost, m.n_eroded, m.n_lost - m.n_eroded);
 
   if (tc.frames_xdmf) write_results(dir, m);
   write_file_atomically(dir / "materials.csv", materials_csv(m));
@@ -245,6 +245,7 @@ int run_transfer_stage(const StageCall& call) {
   s["source_time_s"] = frame.time;
   s["elements_mapped"] = m.n_elements();
   s["elements_lost"] = m.n_lost;
+  s["elements_lost_eroded"] = m.n_eroded;
   s["elements_trimmed"] = m.n_trimmed;
   s["vf_min"] = vf_min;
   s["vf_max"] = vf_max;
