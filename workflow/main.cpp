@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -56,13 +57,27 @@ int main(int argc, char** argv) {
                                  "Run a case: writes summary.json, history.csv, log.txt, "
                                  "results.h5/.xdmf and figures to the output folder");
   run->add_option("case", case_file, "Case file (TOML)")->required();
-  run->add_option("-o,--output", out_dir, "Output folder (default results/<case name>)");
+  run->add_option("-o,--output", out_dir, "Output folder (default results/<case name>)")
+      ->check(CLI::Validator(
+          [](const std::string& s) { return s.empty() ? std::string("an empty output folder") : std::string(); },
+          "FOLDER"));
   run->add_option("--set", overrides,
                   "Override a case key: --set KEY=VALUE (repeatable), e.g. "
                   "--set mesh.resolution=coarse");
   run->add_option("--np", ranks, "MPI ranks (default 1)")->check(CLI::Range(1, 1 << 20));
   run->add_option("--progress-interval", progress, "Seconds between progress lines (default 5)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(
+          [](const std::string& s) {
+            double v = 0;
+            try {
+              v = std::stod(s);
+            } catch (const std::exception&) {
+              return std::string("not a number");
+            }
+            // NaN passes CLI11's PositiveNumber and Range (every comparison with it is false)
+            return std::isfinite(v) && v > 0 ? std::string() : std::string("must be a finite number > 0");
+          },
+          "SECONDS"));
 
   auto* check = app.add_subcommand("check",
                                    "Validate a case without running it (exit 0, or 2 with the "

@@ -63,6 +63,22 @@ INSTANTIATE_TEST_SUITE_P(MalformedCases, BadInput,
                            return f.substr(0, f.find('.'));
                          });
 
+// Command-line values a run cannot use: an empty output folder (it used to fall back to
+// results/<name> silently), a progress interval that is not a finite positive number (NaN passed),
+// a folder given as the case file.
+TEST(Cli, RefusesAnEmptyOutputFolderAndANanInterval) {
+  const auto c = (kSource / "cases/verification/cantilever.toml").string();
+  auto r = run_cli({"run", c, "-o", ""});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("empty output folder"), std::string::npos) << r.output;
+  r = run_cli({"run", c, "--progress-interval", "nan", "-o", fresh_dir("nan_interval").string()});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("progress-interval"), std::string::npos) << r.output;
+  r = run_cli({"check", (kSource / "cases").string()});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("is a folder"), std::string::npos) << r.output;
+}
+
 TEST(Cli, SetOverridesAreCheckedLikeTheFile) {
   const fs::path c = kSource / "cases/verification/cantilever.toml";
   Result r = run_cli({"check", c.string(), "--set", "time.end_tme=1"});
