@@ -16,6 +16,8 @@ void read_tool_stl(const TableReader& t, RigidSurface& s) {
   std::filesystem::path stl = t.string("file");
   if (stl.is_relative()) stl = t.file().parent_path() / stl;
   const double scale = t.number("scale", 1.0, Range::positive());
+  // Before VTK's reader, which prints a dozen error lines of its own for a missing file.
+  if (!std::filesystem::is_regular_file(stl)) t.fail("file", "no such STL file: " + stl.string());
   try {
     s.triangles = std::make_shared<TriangleSurface>(TriangleSurface::read_stl(stl.string(), scale));
   } catch (const std::exception& e) {

@@ -57,7 +57,8 @@ INSTANTIATE_TEST_SUITE_P(MalformedCases, BadInput,
                                            BadCase{"negative_modulus.toml", "material[0].youngs_modulus"},
                                            BadCase{"missing_mesh.toml", "mesh"},
                                            BadCase{"wrong_type.toml", "time.end_time"},
-                                           BadCase{"zero_density.toml", "material[0].density"}),
+                                           BadCase{"zero_density.toml", "material[0].density"},
+                                           BadCase{"missing_stl.toml", "tool[0].file"}),
                          [](const ::testing::TestParamInfo<BadCase>& info) {
                            const std::string f = info.param.file;
                            return f.substr(0, f.find('.'));
