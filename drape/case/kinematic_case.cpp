@@ -51,10 +51,9 @@ KinematicDrapeCase load_kinematic_drape_case(const std::filesystem::path& file,
   KinematicDrapeCase kc;
   kc.file = file;
   kc.overrides = overrides;
-  const TableReader c = root.required_table("case");
-  kc.name = fem::read_case_name(c);
-  c.choice("kind", {"kinematic_drape"}, "");
-  kc.description = c.string("description", "");
+  const auto header = fem::read_stage_case_header(root, "kinematic_drape");
+  kc.name = header.name;
+  kc.description = header.description;
   const auto surfaces = root.tables("surface");
   if (surfaces.empty())
     root.fail("surface", "missing: give at least one [[surface]] (the tool at its final position)");

@@ -42,6 +42,12 @@ V3 read_unit_vector(const TableReader& t, std::string_view key, std::array<doubl
 /// `[case] name` (`case_table` is the [case] table): non-empty, no spaces or slashes (it names
 /// the output folder). Every stage's case has one.
 std::string read_case_name(const TableReader& case_table);
+/// The [case] table of a stage's case: its name (read_case_name), its kind (must be `kind`) and
+/// its description ("" when absent).
+struct StageCaseHeader {
+  std::string name, description;
+};
+StageCaseHeader read_stage_case_header(const TableReader& root, const std::string& kind);
 /// Part names under `key` as indices into mesh.part_names (at least one).
 std::vector<int> part_indices(const TableReader& t, std::string_view key, const Mesh& mesh);
 

@@ -145,6 +145,15 @@ std::string read_case_name(const TableReader& case_table) {
   return name;
 }
 
+StageCaseHeader read_stage_case_header(const TableReader& root, const std::string& kind) {
+  const TableReader c = root.required_table("case");
+  StageCaseHeader h;
+  h.name = read_case_name(c);
+  c.choice("kind", {kind}, "");
+  h.description = c.string("description", "");
+  return h;
+}
+
 std::vector<char> part_node_mask(const Mesh& mesh, int part) {
   std::vector<char> in_part(mesh.n_nodes(), 0);
   mesh.for_each_element_node(

@@ -59,10 +59,9 @@ TransferCase load_transfer_case(const std::filesystem::path& file,
   TransferCase tc;
   tc.file = file;
   tc.overrides = overrides;
-  const TableReader c = root.required_table("case");
-  tc.name = fem::read_case_name(c);
-  c.choice("kind", {"transfer"}, "");
-  tc.description = c.string("description", "");
+  const auto header = fem::read_stage_case_header(root, "transfer");
+  tc.name = header.name;
+  tc.description = header.description;
 
   const TableReader s = root.required_table("source");
   tc.results = s.string("results");
