@@ -61,19 +61,20 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   const double tow = s["fabrics"]["ncf"]["tow_thickness_m"];
   for (const char* tool : {"punch", "blankholder", "blankholder_edge", "die", "die_fillet"})
     EXPECT_LT(s[std::string(tool) + "_max_penetration_m"].get<double>(), 0.25 * tow) << tool;
-  // In the last 5 % of the stroke (the equator within 3.2 mm of the blankholder plane) the flat
-  // annulus between the punch and the die, drawn in and squeezed round the hoop, folds a few of
-  // this mesh's tow elements over the fillet's start (one element across a tow, 6.6 mm long: 17
-  // in the run of 3 December 2026, on the x axis) and the folded elements are eroded. None before,
-  // and at most 0.5 % of them.
+  // At the end of the stroke (from 95 % on in the run of 3 December 2026: the equator within
+  // 3.2 mm of the blankholder plane) the flat annulus between the punch and the die, drawn in and
+  // squeezed round the hoop, folds a few of this mesh's tow elements over the fillet's start (one
+  // element across a tow, 6.6 mm long: 17, 0.3 %, on the x axis) and the folded elements are
+  // eroded. With a margin for another machine's round-off (contact runs diverge late): none in the
+  // first 90 % of the stroke, at most 1 % of the elements.
   const std::size_t hexes = s["elements"]["hex8"];
-  EXPECT_LE(s["eroded_elements"].get<std::size_t>(), hexes / 200);
+  EXPECT_LE(s["eroded_elements"].get<std::size_t>(), hexes / 100);
   {
     const auto h = read_history(out / "history.csv");
     const auto d = h.column("punch_displacement_m"), n = h.column("eroded_elements");
     ASSERT_LT(n, h.columns.size());
     for (const auto& row : h.rows) {
-      if (row[d] < 0.95 * 0.0816) {
+      if (row[d] < 0.90 * 0.0816) {
         EXPECT_EQ(row[n], 0.0) << "erosion at punch travel " << row[d];
       }
     }
