@@ -15,39 +15,16 @@ namespace ncfsim::drape {
 using fem::V3;
 
 FabricFields::FabricFields(std::string name, int ply_a, int ply_b, const fem::ExplicitSolver& s)
-    : name_(std::move(name)) {
+    : name_(std::move(name)), plies_(s, ply_a, ply_b) {
   auto X0 = s.x0.view();
-  double longest = 0;
-  const auto& blocks = s.blocks<fem::Hex8Block>();
-  for (int side = 0; side < 2; ++side) {
-    const int part = side == 0 ? ply_a : ply_b;
-    std::size_t offset = 0;  // hexahedra come first in the results files, block after block
-    for (std::size_t k = 0; k < blocks.size(); offset += blocks[k].n, ++k) {
-      const auto& b = blocks[k];
-      if (b.part != part) continue;
-      for (std::size_t e = 0; e < b.n; ++e) {
-        elements_.emplace_back(k, e);
-        cell_.push_back(offset + e);
-        std::array<std::int32_t, 8> c{};
-        V3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-        for (std::size_t I = 0; I < 8; ++I) {
-          c[I] = b.conn[I * b.n + e];
-          const V3 p = V3::at(X0.data() + 3 * static_cast<std::size_t>(c[I]));
-          lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-          hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-        }
-        longest = std::max(longest, norm(hi - lo));
-        conn_.push_back(c);
-      }
-    }
-    if (side == 0) n_a_ = elements_.size();
-  }
+  const double longest = plies_.longest;
+  const auto& conn = plies_.conn;
   reach_ = 1.5 * longest;  // the nearest element of the other ply lies within a diagonal
   wrinkle_radius_ = 3.0 * longest;
 
   // The blank's outline: nodes of the plies within half an element of its rectangle's edges.
-  if (conn_.empty()) return;
-  const auto& h0 = conn_[0];
+  if (conn.empty()) return;
+  const auto& h0 = conn[0];
   auto X0at = [&](std::int32_t node) {
     return V3::at(X0.data() + 3 * static_cast<std::size_t>(node));
   };
@@ -56,7 +33,7 @@ FabricFields::FabricFields(std::string name, int ply_a, int ply_b, const fem::Ex
   if (std::abs(normal_.z) > 0.9) e1 = {1, 0, 0};  // a blank in a horizontal plane: x, y edges
   const V3 e2 = cross(normal_, e1);
   std::vector<std::int32_t> nodes;
-  for (const auto& h : conn_) nodes.insert(nodes.end(), h.begin(), h.end());
+  for (const auto& h : conn) nodes.insert(nodes.end(), h.begin(), h.end());
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
@@ -158,22 +135,18 @@ void wrinkle_angles(const std::vector<V3>& centroid, const std::vector<V3>& norm
 FabricFields::Values FabricFields::values(const fem::ExplicitSolver& s) const {
   auto X = s.x.view();
   auto X0 = s.x0.view();
-  const std::size_t n = elements_.size();
-  std::vector<V3> centroid(n), fibre(n), normal(n);
-  std::vector<std::int32_t> a, b;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& [k, e] = elements_[i];
-    const auto& blk = s.blocks<fem::Hex8Block>()[k];
-    if (blk.n_eroded && blk.eroded[e]) continue;
-    for (auto node : conn_[i])
-      centroid[i] += 0.125 * V3::at(X.data() + 3 * static_cast<std::size_t>(node));
-    const MidQuad mid(conn_[i], X.data());
-    normal[i] = normalized(cross(mid.d_r(0), mid.d_t(0)));
-    double d[3];
-    fem::hex8_fibre_direction(blk, X.data(), e, d);
-    fibre[i] = {d[0], d[1], d[2]};
-    (i < n_a_ ? a : b).push_back(static_cast<std::int32_t>(i));
-  }
+  const auto& conn = plies_.conn;
+  const std::size_t n = conn.size();
+  const PlyElements::State st = plies_.current(s);
+  const auto& centroid = st.centroid;
+  const auto& a = st.a;
+  const auto& b = st.b;
+  std::vector<V3> normal(n);
+  for (const auto& ply : {a, b})
+    for (auto i : ply) {
+      const MidQuad mid(conn[static_cast<std::size_t>(i)], X.data());
+      normal[static_cast<std::size_t>(i)] = normalized(cross(mid.d_r(0), mid.d_t(0)));
+    }
   std::vector<std::int32_t> nearest(n, -1);
   nearest_in_other_ply(centroid, a, b, reach_, nearest);
   nearest_in_other_ply(centroid, b, a, reach_, nearest);
@@ -184,11 +157,11 @@ FabricFields::Values FabricFields::values(const fem::ExplicitSolver& s) const {
   for (std::size_t i = 0; i < n; ++i) {
     const std::int32_t j = nearest[i];
     if (j < 0) continue;
-    v.shear_deg[i] = shear_angle_deg(fibre[i], fibre[static_cast<std::size_t>(j)]);
+    v.shear_deg[i] = shear_angle_deg(st.fibre[i], st.fibre[static_cast<std::size_t>(j)]);
     // The material point of the other ply now under this element's centre, in its reference
     // state, against the one that lay under it: their distance in the ply plane is the slip.
-    const auto& hj = conn_[static_cast<std::size_t>(j)];
-    const MidQuad now_j(hj, X.data()), ref_j(hj, X0.data()), ref_i(conn_[i], X0.data());
+    const auto& hj = conn[static_cast<std::size_t>(j)];
+    const MidQuad now_j(hj, X.data()), ref_j(hj, X0.data()), ref_i(conn[i], X0.data());
     const auto [r, t] = natural_coordinates(now_j, centroid[i]);
     const V3 n0 = normalized(cross(ref_j.d_r(0), ref_j.d_t(0)));
     V3 d = ref_j.at(r, t) - ref_i.at(0, 0);
@@ -211,11 +184,12 @@ void FabricFields::add_frame_fields(const fem::ExplicitSolver& s,
   };
   const Values v = values(s);
   auto& shear = field("shear_angle_deg");
-  for (std::size_t i = 0; i < cell_.size(); ++i) shear[cell_[i]] = v.shear_deg[i];
+  const auto& cell = plies_.cell;
+  for (std::size_t i = 0; i < cell.size(); ++i) shear[cell[i]] = v.shear_deg[i];
   auto& slip = field("interply_slip_m");
-  for (std::size_t i = 0; i < cell_.size(); ++i) slip[cell_[i]] = v.slip_m[i];
+  for (std::size_t i = 0; i < cell.size(); ++i) slip[cell[i]] = v.slip_m[i];
   auto& wrinkle = field("wrinkle_angle_deg");
-  for (std::size_t i = 0; i < cell_.size(); ++i) wrinkle[cell_[i]] = v.wrinkle_deg[i];
+  for (std::size_t i = 0; i < cell.size(); ++i) wrinkle[cell[i]] = v.wrinkle_deg[i];
 }
 
 void FabricFields::add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const {

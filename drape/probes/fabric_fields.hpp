@@ -25,6 +25,7 @@
 #include <utility>
 #include <vector>
 
+#include "drape/probes/ply_elements.hpp"
 #include "fem/run_measure.hpp"
 
 namespace ncfsim::drape {
@@ -44,10 +45,7 @@ class FabricFields final : public fem::RunMeasure {
 
  private:
   std::string name_;
-  std::vector<std::pair<std::size_t, std::size_t>> elements_;  // (hex block, element), ply a then b
-  std::vector<std::size_t> cell_;                              // results-file cell index of each
-  std::size_t n_a_ = 0;
-  std::vector<std::array<std::int32_t, 8>> conn_;
+  PlyElements plies_;
   double reach_ = 0;
   double wrinkle_radius_ = 0;  // m, the neighbourhood of the wrinkle indicator
   // Draw-in: the blank's plane (centre, normal), its outline nodes, and which of them are nearest

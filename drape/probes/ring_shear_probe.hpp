@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drape/probe_specs.hpp"
+#include "drape/probes/ply_elements.hpp"
 #include "fem/run_measure.hpp"
 
 namespace ncfsim::drape {
@@ -25,9 +26,7 @@ class RingShearMeasure final : public fem::RunMeasure {
 
  private:
   RingShearProbe spec_;
-  std::vector<std::pair<std::size_t, std::size_t>> elements_;  // (hex block, element), ply a then b
-  std::size_t n_a_ = 0;
-  std::vector<std::array<std::int32_t, 8>> conn_;   // per element of elements_
+  PlyElements plies_;
   std::vector<std::array<std::int32_t, 3>> faces_;  // outer-face triangles (mesh nodes)
   double reach_ = 0;                                // m, nearest-element search
 };
