@@ -105,7 +105,7 @@ void read_time(CaseReadContext& ctx) {
   time.max_cycles = tc.integer("max_cycles", 0, 0, std::int64_t{1} << 50);
   time.energy_balance_limit = tc.number("energy_balance_limit", 0.05, Range::open_closed(0, 1));
   time.quasi_static_from =
-      tc.number("quasi_static_from", 0.1 * time.end_time, Range{0, time.end_time, true, false});
+      tc.number("quasi_static_from", 0.1 * time.end_time, Range{0, time.end_time, false, true});
   time.kinetic_to_internal_limit = tc.number("kinetic_to_internal_limit", 0.0, Range::non_negative());
   time.erosion_step_ratio = tc.number("erosion_step_ratio", 0.0, Range{0, 1, false, true});
   if (time.erosion_step_ratio > 0 && time.erosion_step_ratio <= time.min_step_ratio)

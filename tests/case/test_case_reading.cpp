@@ -237,3 +237,16 @@ TEST(CaseReading, VariantCaseIsItsBaseWithItsChanges) {
   EXPECT_EQ(key_of_error(write_case("variant_missing", "[case]\nbase = \"nowhere.toml\"\n")), "case.base");
   EXPECT_EQ(key_of_error(write_case("variant_loop", "[case]\nbase = \"variant_loop.toml\"\n")), "case.base");
 }
+
+// time.quasi_static_from lies in [0, end_time): 0 (the whole run) is allowed, end_time is not.
+TEST(CaseReading, QuasiStaticWindowStartsInsideTheRun) {
+  const std::filesystem::path file =
+      std::filesystem::path(NCFSIM_SOURCE_DIR) / "cases/verification/cantilever.toml";
+  EXPECT_EQ(workflow::load_engine_case(file, {"time.quasi_static_from=0.0"}).model.time.quasi_static_from, 0.0);
+  try {
+    workflow::load_engine_case(file, {"time.end_time=0.04", "time.quasi_static_from=0.04"});
+    ADD_FAILURE() << "a window starting at the end was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "time.quasi_static_from") << e.what();
+  }
+}
