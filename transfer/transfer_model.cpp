@@ -49,6 +49,91 @@ struct FaceRef {
   double radius;  // largest centre-to-corner distance
 };
 
+// Tied pairs: outer faces of the model's hexahedra (at positions x) facing each other across the
+// resin layer, between the plies and between neighbouring tows of a ply.
+std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>& x,
+                                const TieSpec& spec) {
+  std::map<std::array<std::int32_t, 4>, std::pair<std::int32_t, int>> face_of;
+  std::map<std::array<std::int32_t, 4>, int> count;
+  for (std::size_t e = 0; e < m.hex.size(); ++e)
+    for (int f = 0; f < 6; ++f) {
+      std::array<std::int32_t, 4> key{};
+      for (std::size_t k = 0; k < 4; ++k) key[k] = m.hex[e][static_cast<std::size_t>(kFace[f][k])];
+      std::sort(key.begin(), key.end());
+      ++count[key];
+      face_of[key] = {static_cast<std::int32_t>(e), f};
+    }
+  std::vector<FaceRef> faces;
+  double thinnest = 1e300;
+  for (const auto& [key, n] : count) {
+    if (n != 1) continue;
+    const auto [e, f] = face_of[key];
+    std::array<V3, 4> c;
+    for (std::size_t k = 0; k < 4; ++k)
+      c[k] = x[static_cast<std::size_t>(
+          m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(kFace[f][k])])];
+    const V3 centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+    const V3 normal = normalized(cross(c[2] - c[0], c[3] - c[1]));  // outward for VTK face order
+    double radius = 0;
+    for (const auto& p : c) radius = std::max(radius, norm(p - centre));
+    faces.push_back({e, f, centre, normal, radius});
+    if (f == 1) {  // the tow's thickness: top face centre to bottom face centre
+      V3 bottom;
+      for (int k = 0; k < 4; ++k)
+        bottom +=
+            0.25 * x[static_cast<std::size_t>(
+                       m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(kFace[0][k])])];
+      thinnest = std::min(thinnest, norm(centre - bottom));
+    }
+  }
+  const double gap = spec.distance > 0 ? spec.distance : thinnest;
+  std::vector<double> lo(3 * faces.size()), hi(3 * faces.size());
+  for (std::size_t k = 0; k < faces.size(); ++k)
+    for (int d = 0; d < 3; ++d) {
+      const double c = faces[k].centre.arr()[static_cast<std::size_t>(d)],
+                   r = faces[k].radius + gap;
+      lo[3 * k + static_cast<std::size_t>(d)] = c - r;
+      hi[3 * k + static_cast<std::size_t>(d)] = c + r;
+    }
+  fem::BucketGrid grid;
+  if (!faces.empty()) grid.build(faces.size(), lo.data(), hi.data());
+  TiePairs inter{"interply", {}, {}}, intra{"intraply", {}, {}};
+  for (const auto& s : faces) {
+    const auto es = static_cast<std::size_t>(s.element);
+    const double q[3] = {s.centre.x, s.centre.y, s.centre.z};
+    std::int32_t begin = 0, end = 0;
+    if (!grid.cell_of(q, begin, end)) continue;
+    double best = 1e300;
+    const FaceRef* found = nullptr;
+    bool across_plies = false;
+    for (std::int32_t it = begin; it < end; ++it) {
+      const FaceRef& g = faces[static_cast<std::size_t>(grid.items()[it])];
+      const auto eg = static_cast<std::size_t>(g.element);
+      const bool other_ply = m.hex_ply[eg] != m.hex_ply[es];
+      const bool other_tow = !other_ply && m.hex_tow[eg] != m.hex_tow[es];
+      if (!(other_ply ? spec.interply : other_tow && spec.intraply)) continue;
+      // Each bond once: the face of the lower (ply, tow) is the slave.
+      if (std::make_pair(m.hex_ply[es], m.hex_tow[es]) >
+          std::make_pair(m.hex_ply[eg], m.hex_tow[eg]))
+        continue;
+      if (dot(s.normal, g.normal) > -0.5) continue;  // faces that face each other
+      const V3 d = s.centre - g.centre;
+      const double normal_gap = std::abs(dot(d, g.normal));
+      const double in_plane = norm(d - dot(d, g.normal) * g.normal);
+      if (normal_gap > gap || in_plane > g.radius) continue;
+      if (in_plane < best) best = in_plane, found = &g, across_plies = other_ply;
+    }
+    if (!found) continue;
+    TiePairs& t = across_plies ? inter : intra;
+    t.slave.emplace_back(s.element, s.face);
+    t.master.emplace_back(found->element, found->face);
+  }
+  std::vector<TiePairs> ties;
+  if (spec.interply) ties.push_back(std::move(inter));
+  if (spec.intraply) ties.push_back(std::move(intra));
+  return ties;
+}
+
 }  // namespace
 
 std::size_t ImpregnatedModel::n_tie_pairs() const {
@@ -175,84 +260,7 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
     m.hex_tow.push_back(mesh.hex_tow.empty() ? static_cast<std::int32_t>(e) : mesh.hex_tow[e]);
   }
 
-  // Tied pairs: outer faces of the kept hexahedra facing each other across the resin layer.
-  std::map<std::array<std::int32_t, 4>, std::pair<std::int32_t, int>> face_of;
-  std::map<std::array<std::int32_t, 4>, int> count;
-  for (std::size_t e = 0; e < m.hex.size(); ++e)
-    for (int f = 0; f < 6; ++f) {
-      std::array<std::int32_t, 4> key{};
-      for (std::size_t k = 0; k < 4; ++k) key[k] = m.hex[e][static_cast<std::size_t>(kFace[f][k])];
-      std::sort(key.begin(), key.end());
-      ++count[key];
-      face_of[key] = {static_cast<std::int32_t>(e), f};
-    }
-  std::vector<FaceRef> faces;
-  double thinnest = 1e300;
-  for (const auto& [key, n] : count) {
-    if (n != 1) continue;
-    const auto [e, f] = face_of[key];
-    std::array<V3, 4> c;
-    for (std::size_t k = 0; k < 4; ++k)
-      c[k] = tows.current[static_cast<std::size_t>(
-          m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(kFace[f][k])])];
-    const V3 centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
-    const V3 normal = normalized(cross(c[2] - c[0], c[3] - c[1]));  // outward for VTK face order
-    double radius = 0;
-    for (const auto& p : c) radius = std::max(radius, norm(p - centre));
-    faces.push_back({e, f, centre, normal, radius});
-    if (f == 1) {  // the tow's thickness: top face centre to bottom face centre
-      V3 bottom;
-      for (int k = 0; k < 4; ++k)
-        bottom +=
-            0.25 * tows.current[static_cast<std::size_t>(
-                       m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(kFace[0][k])])];
-      thinnest = std::min(thinnest, norm(centre - bottom));
-    }
-  }
-  const double gap = spec.ties.distance > 0 ? spec.ties.distance : thinnest;
-  std::vector<double> lo(3 * faces.size()), hi(3 * faces.size());
-  for (std::size_t k = 0; k < faces.size(); ++k)
-    for (int d = 0; d < 3; ++d) {
-      const double c = faces[k].centre.arr()[static_cast<std::size_t>(d)],
-                   r = faces[k].radius + gap;
-      lo[3 * k + static_cast<std::size_t>(d)] = c - r;
-      hi[3 * k + static_cast<std::size_t>(d)] = c + r;
-    }
-  fem::BucketGrid grid;
-  if (!faces.empty()) grid.build(faces.size(), lo.data(), hi.data());
-  TiePairs inter{"interply", {}, {}}, intra{"intraply", {}, {}};
-  for (const auto& s : faces) {
-    const auto es = static_cast<std::size_t>(s.element);
-    const double q[3] = {s.centre.x, s.centre.y, s.centre.z};
-    std::int32_t begin = 0, end = 0;
-    if (!grid.cell_of(q, begin, end)) continue;
-    double best = 1e300;
-    const FaceRef* found = nullptr;
-    bool across_plies = false;
-    for (std::int32_t it = begin; it < end; ++it) {
-      const FaceRef& g = faces[static_cast<std::size_t>(grid.items()[it])];
-      const auto eg = static_cast<std::size_t>(g.element);
-      const bool other_ply = m.hex_ply[eg] != m.hex_ply[es];
-      const bool other_tow = !other_ply && m.hex_tow[eg] != m.hex_tow[es];
-      if (!(other_ply ? spec.ties.interply : other_tow && spec.ties.intraply)) continue;
-      // Each bond once: the face of the lower (ply, tow) is the slave.
-      if (std::make_pair(m.hex_ply[es], m.hex_tow[es]) >
-          std::make_pair(m.hex_ply[eg], m.hex_tow[eg]))
-        continue;
-      if (dot(s.normal, g.normal) > -0.5) continue;  // faces that face each other
-      const V3 d = s.centre - g.centre;
-      const double normal_gap = std::abs(dot(d, g.normal));
-      const double in_plane = norm(d - dot(d, g.normal) * g.normal);
-      if (normal_gap > gap || in_plane > g.radius) continue;
-      if (in_plane < best) best = in_plane, found = &g, across_plies = other_ply;
-    }
-    if (!found) continue;
-    TiePairs& t = across_plies ? inter : intra;
-    t.slave.emplace_back(s.element, s.face);
-    t.master.emplace_back(found->element, found->face);
-  }
-  if (spec.ties.interply) m.ties.push_back(std::move(inter));
-  if (spec.ties.intraply) m.ties.push_back(std::move(intra));
+  m.ties = tie_pairs(m, tows.current, spec.ties);
   return m;
 }
 
