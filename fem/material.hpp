@@ -42,6 +42,9 @@ class SolidMaterial {
   /// The stiffest tangent the law can reach (e.g. a compacted tow): bounds the stable step.
   virtual Voigt6x6 stable_step_stiffness() const { return elastic_stiffness(); }
   virtual int n_history() const { return 0; }
+  /// History row that flags a failed element (a value >= 1: the engine erodes it at the end of
+  /// the cycle); -1: the law never fails an element.
+  virtual int failure_history_row() const { return -1; }
   virtual void update_stress(const MaterialBatch& batch) const = 0;
 };
 

@@ -26,6 +26,9 @@ struct ElementSet {
   // fill_default_user_ids, kept with their element through renumbering.
   std::vector<std::int32_t> ply;
   std::vector<std::int32_t> tow;
+  // Per-element material axes [n][9] (row-major, axes as columns, global), or empty: the part's
+  // (PartProperties::material_axes). A formed part's tows each have their own fibre direction.
+  std::vector<double> material_axes;
 
   std::size_t size() const { return part.size(); }
   bool empty() const { return part.empty(); }

@@ -101,6 +101,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
     std::copy(mesh.coords.begin(), mesh.coords.end(), X.data());
   }
   build_blocks();
+  for (const auto& g : groups_) material_failure_ = material_failure_ || (g->can_erode() && g->material_can_fail());
   assemble_mass();
   {  // gravity acts on the physical mass only: mass scaling adds inertia, not weight
     auto M = mass.view();
@@ -173,7 +174,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   {
     auto X0 = x0.view();
     auto M = mass.view();
-    ContactSetup setup{&model_.mesh, X0.data(), M.data(), dt_, model_.time.erosion_step_ratio > 0};
+    ContactSetup setup{&model_.mesh, X0.data(), M.data(), dt_, erosion_enabled()};
     for (auto& c : model_.contacts) {
       c->initialise(setup);
       dt_ = std::min(dt_, c->stable_step_limit());
@@ -272,25 +273,34 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
   return "(unknown position)";
 }
 
-void ExplicitSolver::erode(const double* x, const double* v, double dt_erode) {
+void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bool check_steps) {
   const double sf = model_.time.safety_factor;
   std::vector<std::int32_t> gone;  // mesh-wide element indices
-  StableStep left;
+  std::vector<std::size_t> failed;
   for (std::size_t k = 0; k < groups_.size(); ++k) {
     ElementGroup& g = *groups_[k];
     if (!g.can_erode()) continue;
+    failed.clear();
+    g.failed_elements(failed);
+    if (!check_steps && failed.empty()) continue;
     g.element_steps(x, step_scratch_, &jacobian_scratch_);
+    std::vector<char> material_failed(failed.empty() ? 0 : g.size(), 0);
+    for (auto e : failed) material_failed[e] = 1;
     const int nn = g.nodes_per_element();
     const std::size_t offset = model_.mesh.element_offset(g.kind());
+    StableStep left;
     for (std::size_t e = 0; e < g.size(); ++e) {
       const double dt = step_scratch_[e];
-      const bool folded = !(jacobian_scratch_[e] > 0);
-      if (!(sf * dt < dt_erode) && !folded) {
+      const bool folded = check_steps && dt_erode > 0 && !(jacobian_scratch_[e] > 0);
+      const bool too_small = check_steps && dt_erode > 0 && sf * dt < dt_erode;
+      const bool broken = !material_failed.empty() && material_failed[e];
+      if (!too_small && !folded && !broken) {
         if (dt < left.dt) left = {dt, g.user_id(e), g.kind()};
         continue;
       }
       using Cause = ErosionEvent::Cause;
-      const ErosionEvent ev{folded ? Cause::InvertedCorner : Cause::StableStep,
+      const ErosionEvent ev{broken ? Cause::MaterialFailure
+                                   : (folded ? Cause::InvertedCorner : Cause::StableStep),
                             t_,
                             cycle_,
                             g.user_id(e),
@@ -307,7 +317,6 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode) {
       erosions_.push_back(ev);
     }
     group_step_[k] = left;
-    left = StableStep{};
   }
   if (!gone.empty())
     for (auto& c : model_.contacts) c->erode(gone);
@@ -398,13 +407,17 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   }
   // Erosion: a step below the limit is seen at once; folded corners, which develop over many
   // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
+  // A failed material point (damage laws) is eroded in the cycle it fails.
   const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
-  if (dt_erode > 0) {
-    StableStep erodible;
-    for (std::size_t k = 0; k < groups_.size(); ++k)
-      if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
-    if (model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0)
-      erode(X.data(), Vv.data(), dt_erode);
+  if (dt_erode > 0 || material_failure_) {
+    bool check_steps = false;
+    if (dt_erode > 0) {
+      StableStep erodible;
+      for (std::size_t k = 0; k < groups_.size(); ++k)
+        if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
+      check_steps = model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0;
+    }
+    erode(X.data(), Vv.data(), dt_erode, check_steps);
   }
   for (const auto& s : group_step_) take_smaller(st, s);
   energy_.internal += inc.internal;

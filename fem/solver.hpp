@@ -48,7 +48,7 @@ class BlockList {
 
 /// One element removed by erosion.
 struct ErosionEvent {
-  enum class Cause { StableStep, InvertedCorner };
+  enum class Cause { StableStep, InvertedCorner, MaterialFailure };
   Cause cause = Cause::StableStep;
   double time = 0;
   std::int64_t cycle = 0;
@@ -78,7 +78,10 @@ class ExplicitSolver {
   const EnergyBalance& energy() const { return energy_; }
   const StableStep& controlling_element() const { return step_; }
   const std::vector<PartMassReport>& part_masses() const { return part_mass_; }
-  /// Elements eroded so far (time.erosion_step_ratio), in order.
+  /// Whether elements may be eroded: time.erosion_step_ratio set, or a material that fails
+  /// elements (a damage law).
+  bool erosion_enabled() const { return model_.time.erosion_step_ratio > 0 || material_failure_; }
+  /// Elements eroded so far (time.erosion_step_ratio, material failure), in order.
   const std::vector<ErosionEvent>& erosions() const { return erosions_; }
   const PhaseTimers& timers() const { return timers_; }
   std::size_t n_elements(ElementKind kind) const;
@@ -124,7 +127,8 @@ class ExplicitSolver {
   /// Erodes every element of the groups that can lose elements whose step at x (times the
   /// safety factor) is below dt_erode or one of whose corners has folded over (corner Jacobian
   /// <= 0); those groups' steps (group_step_) become the stable step of the elements left.
-  void erode(const double* x, const double* v, double dt_erode);
+  /// Without `check_steps` only the elements the material has failed are eroded.
+  void erode(const double* x, const double* v, double dt_erode, bool check_steps);
   /// "(x, y, z) m": centroid at x of the element a StableStep names (for messages).
   std::string element_position(const StableStep& st, const double* x) const;
 
@@ -135,6 +139,7 @@ class ExplicitSolver {
   PictureFrameMotion* frames_ = nullptr;                   // among motions_
   std::vector<PartMassReport> part_mass_;
   std::vector<ErosionEvent> erosions_;
+  bool material_failure_ = false;  // a group's material can fail elements
   std::vector<double> step_scratch_, jacobian_scratch_;
   /// Elements eroded this cycle: their nodes and nodal internal forces at t^n. Their work over the
   /// first half of the next increment, which the trapezoidal external work counts, is booked

@@ -29,6 +29,8 @@ TowDamageMaterial::TowDamageMaterial(std::string name, const TowDamageConstants&
     require_positive(c.fracture_energy[static_cast<std::size_t>(m)],
                      std::string("fracture_energy_") + kModeNames[static_cast<std::size_t>(m)]);
   }
+  for (int m = 0; m < kModes; ++m)
+    erode_[static_cast<std::size_t>(m)] = c.erode_on[static_cast<std::size_t>(m)] ? 1.0 : 0.0;
   C_ = fem::orthotropic_stiffness(c.elastic);  // throws unless positive definite
   const auto& e = c.elastic;
   modulus_ = {e.E1, e.E1, e.E2, e.E2, e.G12, e.G23};
@@ -75,6 +77,10 @@ void TowDamageMaterial::update_stress(const fem::MaterialBatch& b) const {
       // damage never heals (the length of a crushed element may change its r_f)
       d[m] = h[(12 + m) * s + e] = std::max(h[(12 + m) * s + e], dm);
     }
+    double failed = 0;
+    for (int m = 0; m < kModes; ++m)
+      failed = std::max(failed, erode_[static_cast<std::size_t>(m)] * d[m]);
+    h[kFailedRow * s + e] = failed >= 1.0 ? 1.0 : 0.0;
     const double d1 = S[0] >= 0 ? d[0] : d[1];
     const double d2 = S[1] >= 0 ? d[2] : d[3];
     const double d3 = S[2] >= 0 ? d[2] : d[3];

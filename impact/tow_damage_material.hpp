@@ -16,7 +16,8 @@
 //   degradation: s11 (1 - d_ft or d_fc by its sign), s22 and s33 (1 - d_mt or d_mc by their signs),
 //   s12 and s13 (1 - d_s12)(1 - d_mt)(1 - d_ft): a cracked matrix and broken fibres carry no axial
 //   shear; s23 (1 - d_s23)(1 - d_mt).
-// History per element [kHistory][stride]: total strain (6), r per mode (6), d per mode (6).
+// History per element [kHistory][stride]: total strain (6), r per mode (6), d per mode (6), failed
+// (1 once a mode in `erode_on` is fully damaged: the engine erodes the element).
 // The element lengths along the material axes come with the batch (MaterialBatch::length); a
 // batch without them uses `default_length`.
 #include <array>
@@ -53,11 +54,16 @@ struct TowDamageConstants {
   TowStrength strength;
   FractureEnergies fracture_energy{};
   double default_length = 1e-3;  // m, used when a batch brings no element lengths
+  /// Modes whose full damage fails the element (eroded by the engine): by default the fibre
+  /// modes (a tow whose matrix has cracked still carries its fibres).
+  std::array<bool, kModes> erode_on{true, true, false, false, false, false};
 };
 
 class TowDamageMaterial final : public fem::SolidMaterial {
  public:
-  static constexpr int kHistory = 18;
+  static constexpr int kHistory = 19;
+  static constexpr int kDamageRow = 12;   // d of mode m in row kDamageRow + m
+  static constexpr int kFailedRow = 18;
   /// Throws std::invalid_argument naming the constant and its allowed range.
   TowDamageMaterial(std::string name, const TowDamageConstants& c);
   const std::string& name() const override { return name_; }
@@ -65,6 +71,7 @@ class TowDamageMaterial final : public fem::SolidMaterial {
   double p_wave_modulus() const override;
   fem::Voigt6x6 elastic_stiffness() const override { return C_; }
   int n_history() const override { return kHistory; }
+  int failure_history_row() const override { return kFailedRow; }
   void update_stress(const fem::MaterialBatch& b) const override;
 
   /// The longest element (m) across a crack of mode m that does not snap back: 2 G E / X^2.
@@ -75,7 +82,8 @@ class TowDamageMaterial final : public fem::SolidMaterial {
   std::string name_;
   TowDamageConstants c_;
   fem::Voigt6x6 C_{};
-  std::array<double, kModes> strength_{}, modulus_{}, rf_length_{};  // per mode; rf = rf_length / L
+  std::array<double, kModes> strength_{}, modulus_{}, rf_length_{};
+  std::array<double, kModes> erode_{};  // 1: the mode's full damage fails the element  // per mode; rf = rf_length / L
 };
 
 }  // namespace ncfsim::impact

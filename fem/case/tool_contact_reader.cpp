@@ -194,6 +194,9 @@ std::unique_ptr<ContactAlgorithm> read_tied_contact(const CaseReadContext& ctx,
   c.search_distance = t.number("search_distance", 0.0, {});
   c.normal_strength = t.number("normal_strength", 0.0, {});
   c.shear_strength = t.number("shear_strength", 0.0, {});
+  c.mode_i_energy = t.number("mode_i_energy", 0.0, {});
+  c.mode_ii_energy = t.number("mode_ii_energy", 0.0, {});
+  c.bk_exponent = t.number("bk_exponent", c.bk_exponent, {});
   return std::make_unique<TiedContact>(std::move(c));
 }
 

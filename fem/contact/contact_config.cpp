@@ -75,7 +75,7 @@ void validate(const TiedContactConfig& c) {
   auto key = [&](const std::string& field) { return key_of(c.key_path, c.name, field); };
   if (c.name.empty()) throw InputError(f, from_case ? key("name") : "contact.name", "a tied contact needs a name");
   for (const ContactGroup* g : {&c.slave, &c.master})
-    if (g->parts.empty())
+    if (g->parts.empty() && c.face_pairs.empty())
       throw InputError(f, key(g == &c.slave ? (from_case ? "slave_parts" : "slave") : (from_case ? "master_parts" : "master")),
                        "lists no parts");
   for (int p : c.slave.parts)
@@ -87,6 +87,24 @@ void validate(const TiedContactConfig& c) {
   check_range(f, key("search_distance"), c.search_distance, Range::non_negative());
   check_range(f, key("normal_strength"), c.normal_strength, Range::non_negative());
   check_range(f, key("shear_strength"), c.shear_strength, Range::non_negative());
+  check_range(f, key("mode_i_energy"), c.mode_i_energy, Range::non_negative());
+  check_range(f, key("mode_ii_energy"), c.mode_ii_energy, Range::non_negative());
+  check_range(f, key("bk_exponent"), c.bk_exponent, Range::closed(1, 5));
+  if (c.mode_i_energy > 0 || c.mode_ii_energy > 0) {
+    if (!(c.mode_i_energy > 0) || !(c.mode_ii_energy > 0))
+      throw InputError(f, key(c.mode_i_energy > 0 ? "mode_ii_energy" : "mode_i_energy"),
+                       "a cohesive tie needs both fracture energies > 0");
+    if (!(c.normal_strength > 0) || !(c.shear_strength > 0))
+      throw InputError(f, key(c.normal_strength > 0 ? "shear_strength" : "normal_strength"),
+                       "a cohesive tie (fracture energies given) needs both strengths > 0");
+  }
+  for (std::size_t k = 0; k < c.face_pairs.size(); ++k) {
+    const auto& p = c.face_pairs[k];
+    if (p.slave_face < 0 || p.slave_face > 5 || p.master_face < 0 || p.master_face > 5 ||
+        p.slave_hex < 0 || p.master_hex < 0)
+      throw InputError(f, key("face_pairs"),
+                       "pair " + std::to_string(k + 1) + ": faces must be 0..5 and elements >= 0");
+  }
 }
 
 }  // namespace ncfsim::fem

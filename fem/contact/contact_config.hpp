@@ -67,6 +67,19 @@ struct PenaltyContactConfig {
 /// unbreakable). A failed tie carries no force from then on; the elastic energy it held is
 /// reported as dissipated (friction_dissipation()). Add a PenaltyContact between the same groups
 /// if failed surfaces must still push on each other.
+/// A slave face tied to a master face (faces of hexahedra: mesh hexahedron index, face 0..5 in
+/// kHex8Faces order), e.g. the resin bonds a transfer found between tows and plies.
+struct TiedFacePair {
+  std::int32_t slave_hex = 0, master_hex = 0;
+  int slave_face = 0, master_face = 0;
+};
+
+/// With mode_i_energy > 0 a tie softens instead of failing abruptly: the bilinear mixed-mode
+/// cohesive law of fem/contact/cohesive_law.hpp per slave node, with traction = force / the
+/// node's tributary area, penalty K = k / area, initiation on the quadratic traction criterion of
+/// normal_strength and shear_strength (both > 0), linear softening to a separation set by the
+/// Benzeggagh-Kenane mixed-mode toughness; the energy dissipated by damage is reported with the
+/// friction dissipation and a tie whose damage reaches 1 fails (carries no force).
 struct TiedContactConfig {
   std::string name = "tie";
   ContactGroup slave;          // its surface nodes are tied
@@ -77,6 +90,12 @@ struct TiedContactConfig {
   double search_distance = 0;
   double normal_strength = 0;  // Pa, >= 0; 0: no failure in tension
   double shear_strength = 0;   // Pa, >= 0; 0: no failure in shear
+  double mode_i_energy = 0;    // J/m^2, >= 0; > 0: cohesive softening (needs mode_ii_energy > 0)
+  double mode_ii_energy = 0;   // J/m^2, >= 0
+  double bk_exponent = 1.45;   // Benzeggagh-Kenane eta, [1, 5]
+  /// Explicit face pairs (non-empty: slave and master groups are not used): each node of a slave
+  /// face is tied to the nearest of the master faces paired with its faces.
+  std::vector<TiedFacePair> face_pairs;
   std::string source_file;     // for messages only, may be empty
   std::string key_path;        // for messages only: the case-file table ("contact[1]"), may be empty
 };

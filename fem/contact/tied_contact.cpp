@@ -8,6 +8,7 @@
 #include "fem/contact/contact_surface.hpp"
 #include "fem/contact/segment_frame.hpp"
 #include "fem/errors.hpp"
+#include "fem/mesh.hpp"
 
 namespace ncfsim::fem {
 
@@ -42,10 +43,134 @@ inline void tie_frame(const double (&p)[4][3], double xi, double eta, TieFrame& 
 
 TiedContact::TiedContact(TiedContactConfig config) : cfg_(std::move(config)) { validate(cfg_); }
 
+void TiedContact::add_tie(std::int32_t node, const std::int32_t* corners, double xi, double eta,
+                          std::int32_t seg_hex, double area, const double* x0, const double* mass,
+                          double inv_dt0_sq) {
+  double q[4][3];
+  gather_segment(x0, corners, q);
+  TieFrame tf;
+  tie_frame(q, xi, eta, tf);
+  const double* p = x0 + 3 * static_cast<std::size_t>(node);
+  double off[3] = {0, 0, 0}, m_m = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = p[k] - tf.x[k];
+    off[0] += d * tf.t1[k], off[1] += d * tf.t2[k], off[2] += d * tf.n[k];
+  }
+  for (int a = 0; a < 4; ++a) m_m += tf.N[a] * mass[3 * static_cast<std::size_t>(corners[a])];
+  const double m_s = mass[3 * static_cast<std::size_t>(node)];
+  node_.push_back(node);
+  for (int a = 0; a < 4; ++a) corner_.push_back(corners[a]);
+  seg_hex_.push_back(seg_hex);
+  slave_hex_.push_back(-1);
+  xi_.push_back(xi);
+  eta_.push_back(eta);
+  offset_.insert(offset_.end(), off, off + 3);
+  stiffness_.push_back(cfg_.penalty_scale * m_s * m_m / (m_s + m_m) * inv_dt0_sq);
+  normal_cap_.push_back(cfg_.normal_strength * area);
+  shear_cap_.push_back(cfg_.shear_strength * area);
+  area_.push_back(area);
+}
+
+void TiedContact::initialise_face_pairs(const ContactSetup& setup) {
+  const std::string prefix = cfg_.key_path.empty() ? "contact." + cfg_.name : cfg_.key_path;
+  const ElementSet& hexes = setup.mesh->elements(ElementKind::Hex8);
+  const std::size_t offset = setup.mesh->element_offset(ElementKind::Hex8);
+  const double* x0 = setup.x0;
+  auto face_nodes = [&](std::int32_t h, int f, std::int32_t (&c)[4]) {
+    if (static_cast<std::size_t>(h) >= hexes.size())
+      throw InputError(cfg_.source_file, prefix + ".face_pairs",
+                       "names hexahedron index " + std::to_string(h) + " outside the mesh");
+    const auto nodes = hexes.nodes(static_cast<std::size_t>(h));
+    for (int a = 0; a < 4; ++a) c[a] = nodes[static_cast<std::size_t>(kHex8Faces[static_cast<std::size_t>(f)].corner[static_cast<std::size_t>(a)])];
+  };
+  // Slave faces (each once) give their nodes a quarter of their area; each slave node collects
+  // the master faces paired with its faces.
+  std::vector<std::pair<std::int64_t, std::size_t>> slave_faces;  // key -> first pair
+  for (std::size_t k = 0; k < cfg_.face_pairs.size(); ++k)
+    slave_faces.emplace_back(6 * static_cast<std::int64_t>(cfg_.face_pairs[k].slave_hex) + cfg_.face_pairs[k].slave_face, k);
+  std::sort(slave_faces.begin(), slave_faces.end());
+  struct Candidate {
+    std::int32_t node;
+    std::size_t pair;
+  };
+  std::vector<Candidate> cand;
+  std::vector<double> area(setup.mesh->n_nodes(), 0.0);
+  std::vector<std::int32_t> hex_of(setup.mesh->n_nodes(), -1);
+  for (std::size_t i = 0; i < slave_faces.size(); ++i) {
+    const auto& p = cfg_.face_pairs[slave_faces[i].second];
+    std::int32_t c[4];
+    face_nodes(p.slave_hex, p.slave_face, c);
+    if (i == 0 || slave_faces[i].first != slave_faces[i - 1].first) {
+      double q[4][3];
+      gather_segment(x0, c, q);
+      double d1[3], d2[3];
+      for (int k = 0; k < 3; ++k) d1[k] = q[2][k] - q[0][k], d2[k] = q[3][k] - q[1][k];
+      const double cx = d1[1] * d2[2] - d1[2] * d2[1], cy = d1[2] * d2[0] - d1[0] * d2[2],
+                   cz = d1[0] * d2[1] - d1[1] * d2[0];
+      const double a = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+      for (auto nd : c) area[static_cast<std::size_t>(nd)] += 0.25 * a, hex_of[static_cast<std::size_t>(nd)] = p.slave_hex;
+    }
+    for (auto nd : c) cand.push_back({nd, slave_faces[i].second});
+  }
+  std::sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) {
+    return a.node != b.node ? a.node < b.node : a.pair < b.pair;
+  });
+  const double inv_dt0_sq = 1.0 / (setup.dt * setup.dt);
+  const double r = cfg_.search_distance;  // 0: the pairs are trusted
+  search_distance_ = r;
+  for (std::size_t i = 0; i < cand.size();) {
+    const std::int32_t node = cand[i].node;
+    const double* p = x0 + 3 * static_cast<std::size_t>(node);
+    double best_d2 = r > 0 ? r * r : std::numeric_limits<double>::max();
+    std::int32_t best_c[4] = {0, 0, 0, 0};
+    std::int32_t best_hex = -1;
+    double bxi = 0, beta = 0;
+    for (; i < cand.size() && cand[i].node == node; ++i) {
+      const auto& pr = cfg_.face_pairs[cand[i].pair];
+      std::int32_t c[4];
+      face_nodes(pr.master_hex, pr.master_face, c);
+      if (std::find(c, c + 4, node) != c + 4) continue;
+      double q[4][3];
+      gather_segment(x0, c, q);
+      SegmentFrame f;
+      segment_frame(q, 0, f);
+      const SegmentProjection pj = project_on_segment(f, p[0], p[1], p[2]);
+      const double xi = std::clamp(pj.xi, -1.0, 1.0), eta = std::clamp(pj.eta, -1.0, 1.0);
+      TieFrame tf;
+      tie_frame(q, xi, eta, tf);
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) d2 += (p[k] - tf.x[k]) * (p[k] - tf.x[k]);
+      if (d2 <= best_d2) {
+        best_d2 = d2, bxi = xi, beta = eta, best_hex = pr.master_hex;
+        std::copy(c, c + 4, best_c);
+      }
+    }
+    if (best_hex < 0) continue;
+    add_tie(node, best_c, bxi, beta, static_cast<std::int32_t>(offset) + best_hex,
+            area[static_cast<std::size_t>(node)], x0, setup.mass, inv_dt0_sq);
+    slave_hex_.back() = static_cast<std::int32_t>(offset) + hex_of[static_cast<std::size_t>(node)];
+  }
+}
+
 void TiedContact::initialise(const ContactSetup& setup) {
   const std::string prefix = "contact." + cfg_.name;
   if (!setup.mesh || !setup.x0 || !setup.mass || !(setup.dt > 0))
     throw InputError(cfg_.source_file, prefix, "contact set up without mesh, masses or step");
+  node_.clear(), corner_.clear(), xi_.clear(), eta_.clear(), offset_.clear(), stiffness_.clear();
+  normal_cap_.clear(), shear_cap_.clear(), seg_hex_.clear(), slave_hex_.clear(), area_.clear();
+  cohesive_ = cfg_.mode_i_energy > 0;
+  if (!cfg_.face_pairs.empty()) {
+    initialise_face_pairs(setup);
+    if (node_.empty())
+      throw InputError(cfg_.source_file, prefix + ".face_pairs",
+                       "no slave node lies within the search distance of its paired master faces");
+    alive_.assign(node_.size(), 1);
+    state_.assign(node_.size(), CohesiveState{});
+    n_alive_ = static_cast<std::int64_t>(node_.size());
+    dissipation_ = 0;
+    force_ = {};
+    return;
+  }
   ContactGroup slave = cfg_.slave, master = cfg_.master;
   if (slave.name.empty()) slave.name = "slave";
   if (master.name.empty()) master.name = "master";
@@ -108,36 +233,30 @@ void TiedContact::initialise(const ContactSetup& setup) {
       if (d2 <= best_d2) best_d2 = d2, best = static_cast<std::int32_t>(s), bxi = xi, beta = eta;
     }
     if (best < 0) continue;
-    const auto s = static_cast<std::size_t>(best);
-    double q[4][3];
-    gather_segment(x0, &surf.seg_nodes[4 * s], q);
-    TieFrame tf;
-    tie_frame(q, bxi, beta, tf);
-    double off[3] = {0, 0, 0}, m_m = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double d = p[k] - tf.x[k];
-      off[0] += d * tf.t1[k], off[1] += d * tf.t2[k], off[2] += d * tf.n[k];
-    }
-    for (int a = 0; a < 4; ++a)
-      m_m += tf.N[a] * mass[3 * static_cast<std::size_t>(surf.seg_nodes[4 * s + a])];
-    const double m_s = mass[3 * static_cast<std::size_t>(node)];
-    node_.push_back(node);
-    for (int a = 0; a < 4; ++a) corner_.push_back(surf.seg_nodes[4 * s + a]);
-    seg_hex_.push_back(surf.seg_hex[s]);
-    xi_.push_back(bxi);
-    eta_.push_back(beta);
-    offset_.insert(offset_.end(), off, off + 3);
-    stiffness_.push_back(cfg_.penalty_scale * m_s * m_m / (m_s + m_m) * inv_dt0_sq);
-    normal_cap_.push_back(cfg_.normal_strength * surf.node_area[e]);
-    shear_cap_.push_back(cfg_.shear_strength * surf.node_area[e]);
+    add_tie(node, &surf.seg_nodes[4 * static_cast<std::size_t>(best)], bxi, beta,
+            surf.seg_hex[static_cast<std::size_t>(best)], surf.node_area[e], x0, mass, inv_dt0_sq);
   }
   if (node_.empty())
     throw InputError(cfg_.source_file, prefix + ".search_distance",
                      "no slave node lies within " + std::to_string(r) + " m of the master surface");
   alive_.assign(node_.size(), 1);
+  state_.assign(node_.size(), CohesiveState{});
   n_alive_ = static_cast<std::int64_t>(node_.size());
   dissipation_ = 0;
   force_ = {};
+}
+
+double TiedContact::tied_area() const {
+  double a = 0;
+  for (double v : area_) a += v;
+  return a;
+}
+
+double TiedContact::failed_area() const {
+  double a = 0;
+  for (std::size_t t = 0; t < area_.size(); ++t)
+    if (!alive_[t]) a += area_[t];
+  return a;
 }
 
 void TiedContact::add_forces(const double* x, const double*, const double*, double, double* f) {
@@ -158,6 +277,37 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
     const double k = stiffness_[t];
     const double dn = d[0] * tf.n[0] + d[1] * tf.n[1] + d[2] * tf.n[2];
     const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if (cohesive_) {
+      // Tractions from the bilinear law at this node's separations (K = k / area); the energy
+      // the damage increment releases, 1/2 dd K dm^2 per area, is dissipated.
+      const double A = area_[t];
+      const CohesiveLaw law{k / A, cfg_.normal_strength, cfg_.shear_strength, cfg_.mode_i_energy,
+                            cfg_.mode_ii_energy, cfg_.bk_exponent};
+      const double ds = std::sqrt(std::max(d2 - dn * dn, 0.0));
+      CohesiveState& st = state_[t];
+      const double d_old = st.damage;
+      double tn = 0, ts = 0;
+      cohesive_tractions(law, dn, ds, st, tn, ts);
+      const double dnp = std::max(dn, 0.0);
+      released += 0.5 * (st.damage - d_old) * k * (dnp * dnp + ds * ds);
+      if (alive_[t] == 2 || (st.damage >= 1.0 && dn >= 0)) {
+        alive_[t] = 0;
+        ++failed;
+        released += 0.5 * (1 - st.damage) * k * (dnp * dnp + ds * ds) + (dn < 0 ? 0.5 * k * dn * dn : 0.0);
+        continue;
+      }
+      // Force on the slave node: -A (tn n + ts s), s the sliding direction.
+      double Fv[3];
+      const double is = ds > 0 ? ts * A / ds : 0.0;
+      for (int c = 0; c < 3; ++c) Fv[c] = -(tn * A * tf.n[c] + is * (d[c] - dn * tf.n[c]));
+      f[i] += Fv[0], f[i + 1] += Fv[1], f[i + 2] += Fv[2];
+      for (int a = 0; a < 4; ++a) {
+        const auto j = 3 * static_cast<std::size_t>(corner_[4 * t + a]);
+        f[j] -= tf.N[a] * Fv[0], f[j + 1] -= tf.N[a] * Fv[1], f[j + 2] -= tf.N[a] * Fv[2];
+      }
+      Rx += Fv[0], Ry += Fv[1], Rz += Fv[2];
+      continue;
+    }
     const double tension = dn > 0 ? k * dn : 0.0;
     const double shear = k * std::sqrt(std::max(d2 - dn * dn, 0.0));
     double crit = 0;
@@ -183,10 +333,11 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
 }
 
 void TiedContact::erode(const std::vector<std::int32_t>& mesh_elements) {
+  std::vector<std::int32_t> gone(mesh_elements);
+  std::sort(gone.begin(), gone.end());
+  auto is_gone = [&](std::int32_t h) { return h >= 0 && std::binary_search(gone.begin(), gone.end(), h); };
   for (std::size_t t = 0; t < node_.size(); ++t)
-    if (alive_[t] &&
-        std::find(mesh_elements.begin(), mesh_elements.end(), seg_hex_[t]) != mesh_elements.end())
-      alive_[t] = 2;
+    if (alive_[t] && (is_gone(seg_hex_[t]) || is_gone(slave_hex_[t]))) alive_[t] = 2;
 }
 
 std::vector<ContactResultant> TiedContact::resultants() const {

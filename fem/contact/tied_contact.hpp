@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "fem/contact/cohesive_law.hpp"
 #include "fem/contact/contact_config.hpp"
 #include "fem/contact_interface.hpp"
 
@@ -35,10 +36,22 @@ class TiedContact final : public ContactAlgorithm {
   const TiedContactConfig& config() const { return cfg_; }
   std::size_t n_ties() const { return node_.size(); }
   std::size_t n_failed() const { return node_.size() - static_cast<std::size_t>(n_alive_); }
+  /// Tributary area of the ties (m^2): all, and of the failed ones.
+  double tied_area() const;
+  double failed_area() const;
+  /// Damage of each tie (0: intact, 1: separated; abrupt ties jump from 0 to 1).
+  double damage(std::size_t t) const { return alive_[t] ? state_[t].damage : 1.0; }
   double search_distance() const { return search_distance_; }
 
  private:
+  /// Ties each node of the configured slave faces to the nearest of its paired master faces.
+  void initialise_face_pairs(const ContactSetup& setup);
+  void add_tie(std::int32_t node, const std::int32_t* corners, double xi, double eta,
+               std::int32_t seg_hex, double area, const double* x0, const double* mass,
+               double inv_dt0_sq);
+
   TiedContactConfig cfg_;
+  bool cohesive_ = false;
   double search_distance_ = 0;
   // One entry per tie (structure of arrays).
   std::vector<std::int32_t> node_;    // [n_tie] slave node
@@ -49,6 +62,9 @@ class TiedContact final : public ContactAlgorithm {
   std::vector<double> normal_cap_;    // [n_tie] tensile strength * area, N (0: none)
   std::vector<double> shear_cap_;     // [n_tie] shear strength * area, N (0: none)
   std::vector<std::int32_t> seg_hex_;  // [n_tie] hexahedron owning the master segment
+  std::vector<std::int32_t> slave_hex_;  // [n_tie] a hexahedron of the slave face (-1: unknown)
+  std::vector<double> area_;             // [n_tie] tributary area, m^2
+  std::vector<CohesiveState> state_;     // [n_tie] cohesive state (cohesive ties)
   std::vector<std::uint8_t> alive_;    // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
   std::int64_t n_alive_ = 0;
   double dissipation_ = 0;

@@ -75,6 +75,10 @@ class ElementGroup {
     return 0;
   }
   virtual std::size_t n_eroded() const { return 0; }
+  /// Whether the group's material can fail an element (SolidMaterial::failure_history_row).
+  virtual bool material_can_fail() const { return false; }
+  /// Appends the elements (group indices) the material has failed and that are not eroded yet.
+  virtual void failed_elements(std::vector<std::size_t>& out) const { (void)out; }
 
   /// Per-element output fields of this kind and their values for the group's elements:
   /// out[k] points to [size()][components of field k] of cell_fields()[k].

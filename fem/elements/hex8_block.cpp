@@ -174,8 +174,10 @@ inline double directional_step(double rho, double cg_bound, double step_modulus,
 
 }  // namespace
 
-void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& M) {
+void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& part_axes,
+                     const double* element_axes) {
   const std::size_t n = b.n;
+  b.axis_length.assign(3 * n, 0.0);
   b.stress.assign(6 * n, 0.0);
   b.strain.assign(6 * n, 0.0);
   b.history.assign(static_cast<std::size_t>(b.material->n_history()) * n, 0.0);
@@ -196,13 +198,31 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
   std::array<double, 9> last_T{};
   std::array<double, 6> last_moduli{};
   bool have_last = false;
+  std::array<double, 9> M = part_axes;
   for (std::size_t e = 0; e < n; ++e) {
+    if (element_axes)
+      for (int k = 0; k < 9; ++k) M[static_cast<std::size_t>(k)] = element_axes[k * n + e];
     Vec3 xe[8];
     gather(b, e, x_ref, xe);
     HexGeometry g;
     hex_geometry(xe, g);
     if (!(g.V > 0)) throw_bad_volume(b, e, xe, g.V);
     b.volume[e] = g.V;
+    {
+      // Face area vectors (half the cross product of the diagonals); the projection of the
+      // element on the plane normal to an axis has half the sum of their |components| on it.
+      constexpr int kFaces[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                    {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+      double projected[3] = {0, 0, 0};
+      for (const auto& f : kFaces) {
+        const Vec3 A = 0.5 * cross(xe[f[2]] - xe[f[0]], xe[f[3]] - xe[f[1]]);
+        for (int c = 0; c < 3; ++c)
+          projected[c] += 0.5 * std::abs(A.x * M[static_cast<std::size_t>(c)] +
+                                         A.y * M[static_cast<std::size_t>(3 + c)] +
+                                         A.z * M[static_cast<std::size_t>(6 + c)]);
+      }
+      for (int c = 0; c < 3; ++c) b.axis_length[c * n + e] = projected[c] > 0 ? g.V / projected[c] : 0.0;
+    }
     double R[9], l[3];
     hex_frame(g, R, l);
     // Inverse of the centre Jacobian [a1 a2 a3]: F = J J_ref^{-1} exactly for homogeneous motion.
@@ -639,6 +659,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
     batch.strain_increment = &deps[0][0];
     batch.stress = stress + e0;
     batch.history = b.history.empty() ? nullptr : b.history.data() + e0;
+    batch.length = b.axis_length.empty() ? nullptr : b.axis_length.data() + e0;
     batch.dt = dt;
     b.material->update_stress(batch);
 

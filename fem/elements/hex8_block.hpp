@@ -55,12 +55,19 @@ struct Hex8Block {
   // used) for an isotropic material.
   std::vector<double> step_modulus;  // [n] Pa
   std::vector<double> step_length0;  // [n] m
+  // [3][n] reference length of the element along each material axis: volume over the area of
+  // its projection on the plane normal to the axis (the edge length of a box along its axes).
+  // Damage laws regularise their softening with it (crack band); MaterialBatch::length.
+  std::vector<double> axis_length;
 };
 
 /// Sets up a block from reference coordinates: volumes, frames, hourglass moduli, density.
 /// `material_axes_global` (row-major, axes as columns) gives the material axes in the reference
-/// configuration. Throws NumericalError naming the element if a volume is not positive.
-void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& material_axes_global);
+/// configuration; `element_axes` [9][n] (same layout, per element, block order), when given,
+/// replaces it element by element. Throws NumericalError naming the element if a volume is not
+/// positive.
+void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& material_axes_global,
+                     const double* element_axes = nullptr);
 
 /// Element nodal masses (rho V / 8) added into `mass` [3*n_nodes].
 void hex8_lumped_mass(const Hex8Block& b, double* mass);

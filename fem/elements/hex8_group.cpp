@@ -50,6 +50,14 @@ class Hex8Group final : public ElementGroup {
   }
   double erode(std::size_t e) override { return hex8_erode(block, e); }
   std::size_t n_eroded() const override { return block.n_eroded; }
+  bool material_can_fail() const override { return block.material->failure_history_row() >= 0; }
+  void failed_elements(std::vector<std::size_t>& out) const override {
+    const int row = block.material->failure_history_row();
+    if (row < 0) return;
+    const double* f = block.history.data() + static_cast<std::size_t>(row) * block.n;
+    for (std::size_t e = 0; e < block.n; ++e)
+      if (f[e] >= 1.0 && !(block.n_eroded && block.eroded[e])) out.push_back(e);
+  }
   std::vector<CellFieldSpec> cell_fields() const override {
     return {{"stress", 6}, {"von_mises_stress", 1}, {"fibre_direction", 3}, {"eroded", 1}};
   }
@@ -85,7 +93,13 @@ std::unique_ptr<ElementGroup> make_hex8_group(const Model& model, const ElementS
   }
   b.hourglass_stiffness = pp.hourglass_stiffness;
   b.hourglass_viscosity = pp.hourglass_viscosity;
-  hex8_initialise(b, x_ref, pp.material_axes);
+  std::vector<double> element_axes;  // [9][n], block order
+  if (!set.material_axes.empty()) {
+    element_axes.resize(9 * b.n);
+    for (std::size_t j = 0; j < b.n; ++j)
+      for (std::size_t k = 0; k < 9; ++k) element_axes[k * b.n + j] = set.material_axes[9 * elements[j] + k];
+  }
+  hex8_initialise(b, x_ref, pp.material_axes, element_axes.empty() ? nullptr : element_axes.data());
   g->bind();
   return g;
 }

@@ -144,14 +144,21 @@ void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size
   const std::size_t before = logged;
   for (; logged < s.erosions().size(); ++logged) {
     const auto& ev = s.erosions()[logged];
+    const auto& part = s.model().mesh.part_names[static_cast<std::size_t>(ev.part)];
+    if (ev.cause == fem::ErosionEvent::Cause::MaterialFailure) {
+      // Part of a damage law's progress (thousands in a crush): the log file has them.
+      log.debug("hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, {:.6g}) m: its "
+                "material failed",
+                ev.element, part, ev.time, ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z);
+      continue;
+    }
     const std::string why = ev.cause == fem::ErosionEvent::Cause::InvertedCorner
                                 ? "a corner folded over (corner Jacobian <= 0)"
                                 : fmt::format("its step {:.3g} s fell below time.erosion_step_ratio = {:g} of the "
                                               "initial one",
                                               ev.step, tc.erosion_step_ratio);
     log.warn("hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, {:.6g}) m: {}", ev.element,
-             s.model().mesh.part_names[static_cast<std::size_t>(ev.part)], ev.time, ev.cycle, ev.centroid.x,
-             ev.centroid.y, ev.centroid.z, why);
+             part, ev.time, ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z, why);
   }
   if (logged > before)
     for (auto& m : measures)

@@ -78,7 +78,7 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
     fr.fields.push_back(std::move(vm));
     fr.fields.push_back(std::move(fibre));
   }
-  if (nh && s.model().time.erosion_step_ratio > 0) {
+  if (nh && s.erosion_enabled()) {
     // 1 where a hexahedron was eroded (ParaView: threshold it away)
     fem::io::FrameField eroded{"eroded", true, 1, std::vector<double>(nh + nb, 0.0)};
     std::size_t o = 0;

@@ -159,7 +159,7 @@ std::unique_ptr<fem::RunMeasure> make_bias_extension_curve(const EngineCase& ec)
 MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s) {
   const fem::Model& model = s.model();
   MeasureList m;
-  m.push_back(std::make_unique<EnergyColumns>(model.time.erosion_step_ratio > 0));
+  m.push_back(std::make_unique<EnergyColumns>(s.erosion_enabled()));
   for (const auto& t : model.tools) m.push_back(std::make_unique<ToolMeasure>(t));
   for (const auto& r : ec.reactions) m.push_back(std::make_unique<ReactionMeasure>(r));
   for (std::size_t k = 0; k < model.picture_frames.size(); ++k)
