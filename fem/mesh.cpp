@@ -180,6 +180,7 @@ std::vector<std::int32_t> renumber_for_locality(Mesh& mesh) {
     apply_order(s.ply, order);
     apply_order(s.tow, order);
     if (!s.material_axes.empty()) apply_order(s.material_axes, order, 9);
+    if (!s.material.empty()) apply_order(s.material, order);
   }
 
   // Nodes by first use, sets in kind order.

@@ -29,6 +29,9 @@ struct ElementSet {
   // Per-element material axes [n][9] (row-major, axes as columns, global), or empty: the part's
   // (PartProperties::material_axes). A formed part's tows each have their own fibre direction.
   std::vector<double> material_axes;
+  // Per-element material (index into Model::materials; -1: the part's), or empty: the part's. A
+  // formed part's tows each have their fibre volume fraction, so their own impregnated material.
+  std::vector<std::int32_t> material;
 
   std::size_t size() const { return part.size(); }
   bool empty() const { return part.empty(); }

@@ -46,6 +46,16 @@ class RunMeasure {
   /// Appends its values at a history row: one per column it added (add_columns, then
   /// add_late_columns), in the same order. `row` holds the values of the measures before it.
   virtual void add_values(const ExplicitSolver& s, std::vector<double>& row) const { (void)s, (void)row; }
+  /// Whether it adds columns computed from the whole history once the run has ended
+  /// (add_final_columns): the run then keeps every history row.
+  virtual bool needs_final_columns() const { return false; }
+  /// Once at the end: columns that need every row (a filter without lag needs the samples after
+  /// a row), appended to `columns` and to each row of `rows`; history.csv is then rewritten
+  /// (atomically) with them.
+  virtual void add_final_columns(std::vector<std::string>& columns,
+                                 std::vector<std::vector<double>>& rows) const {
+    (void)columns, (void)rows;
+  }
   /// After a cycle in which hexahedra were eroded (the erosions are logged before): warning lines
   /// of what the measure saw change (e.g. stitch joints released).
   virtual std::vector<std::string> after_erosion(const ExplicitSolver& s) { (void)s; return {}; }

@@ -1,6 +1,7 @@
 #include "fem/solver.hpp"
 
 #include <algorithm>
+#include <map>
 #include <array>
 #include <cmath>
 #include <sstream>
@@ -213,7 +214,15 @@ void ExplicitSolver::build_blocks() {
                              element_noun(static_cast<ElementKind>(kind_of_part[p])) + " and " +
                              element_noun(set.kind) + " elements");
       kind_of_part[p] = static_cast<int>(set.kind);
-      groups_.push_back(make_element_group(model_, set, static_cast<int>(p), of_part[p], X.data()));
+      if (set.material.empty()) {
+        groups_.push_back(make_element_group(model_, set, static_cast<int>(p), of_part[p], X.data()));
+        continue;
+      }
+      // Elements with their own material: one group per material of the part (batches of one law).
+      std::map<std::int32_t, std::vector<std::size_t>> of_material;
+      for (auto e : of_part[p]) of_material[set.material[e]].push_back(e);
+      for (const auto& [material, elements] : of_material)
+        groups_.push_back(make_element_group(model_, set, static_cast<int>(p), elements, X.data()));
     }
   }
   group_step_.resize(groups_.size());

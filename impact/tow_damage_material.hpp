@@ -57,6 +57,7 @@ struct TowDamageConstants {
   /// Modes whose full damage fails the element (eroded by the engine): by default the fibre
   /// modes (a tow whose matrix has cracked still carries its fibres).
   std::array<bool, kModes> erode_on{true, true, false, false, false, false};
+  std::string fracture_energy_key;  // case-file key of the fracture energies, for messages
 };
 
 class TowDamageMaterial final : public fem::SolidMaterial {

@@ -11,6 +11,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "fem/errors.hpp"
+#include "fem/elements/element_kind.hpp"
 #include "fem/elements/hex8_basis.hpp"
 #include "fem/elements/simd_batch.hpp"
 
@@ -174,6 +175,31 @@ inline double directional_step(double rho, double cg_bound, double step_modulus,
 
 }  // namespace
 
+std::array<double, 3> hex8_axis_lengths(const double (&x)[8][3], const std::array<double, 9>& M) {
+  // Face area vectors (half the cross product of the diagonals); the projection of the element
+  // on the plane normal to an axis has half the sum of their |components| along it.
+  double V = 0;
+  {
+    Vec3 xe[8];
+    for (int I = 0; I < 8; ++I) xe[I] = {x[I][0], x[I][1], x[I][2]};
+    HexGeometry g;
+    hex_geometry(xe, g);
+    V = g.V;
+  }
+  double projected[3] = {0, 0, 0};
+  for (const auto& f : kHex8Faces) {
+    const auto& c = f.corner;
+    const Vec3 d1{x[c[2]][0] - x[c[0]][0], x[c[2]][1] - x[c[0]][1], x[c[2]][2] - x[c[0]][2]};
+    const Vec3 d2{x[c[3]][0] - x[c[1]][0], x[c[3]][1] - x[c[1]][1], x[c[3]][2] - x[c[1]][2]};
+    const Vec3 A = 0.5 * cross(d1, d2);
+    for (std::size_t k = 0; k < 3; ++k)
+      projected[k] += 0.5 * std::abs(A.x * M[k] + A.y * M[3 + k] + A.z * M[6 + k]);
+  }
+  std::array<double, 3> L{};
+  for (std::size_t k = 0; k < 3; ++k) L[k] = projected[k] > 0 ? V / projected[k] : 0.0;
+  return L;
+}
+
 void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& part_axes,
                      const double* element_axes) {
   const std::size_t n = b.n;
@@ -209,19 +235,10 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
     if (!(g.V > 0)) throw_bad_volume(b, e, xe, g.V);
     b.volume[e] = g.V;
     {
-      // Face area vectors (half the cross product of the diagonals); the projection of the
-      // element on the plane normal to an axis has half the sum of their |components| on it.
-      constexpr int kFaces[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                                    {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-      double projected[3] = {0, 0, 0};
-      for (const auto& f : kFaces) {
-        const Vec3 A = 0.5 * cross(xe[f[2]] - xe[f[0]], xe[f[3]] - xe[f[1]]);
-        for (int c = 0; c < 3; ++c)
-          projected[c] += 0.5 * std::abs(A.x * M[static_cast<std::size_t>(c)] +
-                                         A.y * M[static_cast<std::size_t>(3 + c)] +
-                                         A.z * M[static_cast<std::size_t>(6 + c)]);
-      }
-      for (int c = 0; c < 3; ++c) b.axis_length[c * n + e] = projected[c] > 0 ? g.V / projected[c] : 0.0;
+      double xr[8][3];
+      for (int I = 0; I < 8; ++I) xr[I][0] = xe[I].x, xr[I][1] = xe[I].y, xr[I][2] = xe[I].z;
+      const auto L = hex8_axis_lengths(xr, M);
+      for (int c = 0; c < 3; ++c) b.axis_length[static_cast<std::size_t>(c) * n + e] = L[static_cast<std::size_t>(c)];
     }
     double R[9], l[3];
     hex_frame(g, R, l);

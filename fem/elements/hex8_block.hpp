@@ -12,6 +12,7 @@
 //    with the parasitic shear of bending removed (Belytschko-Bindeman type). One element through
 //    a thin layer then bends with the right stiffness. A small viscous part damps hourglass
 //    noise; only that part is non-physical and is reported as hourglass energy.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -24,6 +25,7 @@ namespace ncfsim::fem {
 struct Hex8Block {
   int part = 0;
   const SolidMaterial* material = nullptr;  // borrowed, outlives the block
+  int material_index = -1;                   // index into Model::materials
   std::size_t n = 0;
   std::vector<std::int32_t> conn;      // [8][n] node indices
   std::vector<std::int64_t> user_id;   // [n]
@@ -68,6 +70,11 @@ struct Hex8Block {
 /// positive.
 void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& material_axes_global,
                      const double* element_axes = nullptr);
+
+/// Length of a hexahedron (corners x, VTK order) along each of the axes (row-major, axes as
+/// columns): its volume over the area of its projection on the plane normal to the axis (a box's
+/// edge lengths along its own axes). The crack-band width of a crack normal to the axis.
+std::array<double, 3> hex8_axis_lengths(const double (&x)[8][3], const std::array<double, 9>& axes);
 
 /// Element nodal masses (rho V / 8) added into `mass` [3*n_nodes].
 void hex8_lumped_mass(const Hex8Block& b, double* mass);

@@ -73,14 +73,18 @@ std::unique_ptr<ElementGroup> make_hex8_group(const Model& model, const ElementS
                                               const std::vector<std::size_t>& elements,
                                               const double* x_ref) {
   const PartProperties& pp = model.parts[static_cast<std::size_t>(part)];
-  if (pp.material < 0 || static_cast<std::size_t>(pp.material) >= model.materials.size())
+  const int material = !set.material.empty() && !elements.empty() && set.material[elements.front()] >= 0
+                           ? set.material[elements.front()]
+                           : pp.material;
+  if (material < 0 || static_cast<std::size_t>(material) >= model.materials.size())
     throw InputError("",
                      "part." + model.mesh.part_names[static_cast<std::size_t>(part)] + ".material",
                      "no such material");
   auto g = std::make_unique<Hex8Group>();
   Hex8Block& b = g->block;
   b.part = part;
-  b.material = model.materials[static_cast<std::size_t>(pp.material)].get();
+  b.material = model.materials[static_cast<std::size_t>(material)].get();
+  b.material_index = material;
   b.n = elements.size();
   b.conn.resize(8 * b.n);
   b.user_id.resize(b.n);

@@ -17,7 +17,7 @@ using fem::TableReader;
 void read_case_header(const TableReader& root, EngineCase& ec) {
   const TableReader c = root.required_table("case");
   ec.name = fem::read_case_name(c);
-  ec.kind = c.choice("kind", {"engine"}, "engine");
+  ec.kind = c.choice("kind", {"engine", "crush"}, "engine");
   ec.description = c.string("description", "");
 }
 
@@ -119,7 +119,10 @@ PictureSpec read_picture(const TableReader& t, const fem::Mesh& mesh) {
   p.field = t.choice("field",
                      {"displacement_magnitude", "displacement", "velocity", "stress",
                       "von_mises_stress", "fibre_direction", "axial_force", "axial_strain",
-                      "shear_angle_deg", "interply_slip_m", "wrinkle_angle_deg", "none"},
+                      "shear_angle_deg", "interply_slip_m", "wrinkle_angle_deg", "vf",
+                      "damage_fibre_tension", "damage_fibre_compression", "damage_matrix_tension",
+                      "damage_matrix_compression", "damage_in_plane_shear",
+                      "damage_transverse_shear", "failed_mode", "eroded", "none"},
                      "displacement_magnitude");
   p.component = static_cast<int>(t.integer("component", -1, -1, 5));
   p.camera = t.choice("camera", {"iso", "top", "front"}, "iso");
@@ -150,6 +153,7 @@ fem::CaseTypeRegistry engine_case_types() {
   fem::CaseTypeRegistry types;
   fem::register_fem_case_types(types);
   drape::register_drape_case_types(types);
+  impact::register_impact_case_types(types);
   return types;
 }
 
@@ -161,11 +165,23 @@ EngineCase load_engine_case(const std::filesystem::path& file,
   ec.file = file;
   CaseReadContext ctx(doc, ec.model, types);
   read_case_header(ctx.root, ec);
-  auto fabrics = read_mesh(ctx);
+  // The mesh: [mesh] blocks and fabrics, or [model], the impregnated part a transfer wrote.
+  const bool imported = impact::has_impregnated_model(ctx);
+  if (imported && ctx.root.has("mesh"))
+    ctx.root.fail("model", "give either [mesh] or [model] (an imported transfer result), not both");
+  if (ec.kind == "crush" && !imported)
+    ctx.root.fail("model", "missing: a crush case reads its part from a transfer's results ([model] source = ...)");
+  impact::ImpregnatedImport import;
+  std::vector<drape::FabricEntry> fabrics;
+  if (imported)
+    import = impact::read_impregnated_model(ctx);
+  else
+    fabrics = read_mesh(ctx);
   ec.resolution = ctx.resolution;
   fem::read_materials(ctx);
   fem::read_bar_laws(ctx);
   fem::read_parts(ctx);
+  if (imported) impact::assign_impregnated_parts(ctx, import);
   ec.fabric_summaries = drape::assign_fabric_parts(ctx, fabrics);
   fem::check_parts_defined(ctx);
   fem::read_boundary(ctx);
@@ -175,8 +191,10 @@ EngineCase load_engine_case(const std::filesystem::path& file,
   fem::read_time(ctx);
   collect_reactions(ec);
   ec.frame_fabric_length = ctx.frame_fabric_length;
+  ec.crush = impact::read_crush(ctx);
   read_output(ctx, ec);
   read_figures(ctx, ec);
+  impact::check_crack_band(ctx);
   doc.check_unknown_keys();
   return ec;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drape/probe_specs.hpp"
+#include "impact/case/crush_case.hpp"
 #include "fem/model.hpp"
 
 namespace ncfsim::fem {
@@ -120,9 +121,11 @@ struct EngineCase {
   std::vector<BendingLengthProbe> bending;
   std::vector<SummaryMean> means;
   std::vector<double> frame_fabric_length;  // per picture frame: side of the fabric for normalising
+  impact::CrushSpec crush;                    // [crush]: the punch's measures (kind crush)
 };
 
-/// The material types an engine case knows: fem's, then drape's (tow_biphase).
+/// The material types an engine case knows: fem's, then drape's (tow_biphase), then impact's
+/// (tow_damage).
 fem::CaseTypeRegistry engine_case_types();
 
 /// Reads and checks a case (throws InputError naming file and key). `overrides` are --set items.

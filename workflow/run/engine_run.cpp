@@ -307,6 +307,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   r.write_summary();
   int exit_code = time_loop(r, solver, measures, history, frames);
   frames.close();
+  history.finish();
 
   const auto& tc = solver.model().time;
   const double err = solver.energy().error();

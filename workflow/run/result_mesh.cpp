@@ -18,7 +18,7 @@ fem::io::ResultMesh result_mesh(const fem::ExplicitSolver& s) {
   const fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
   const bool tagged = hexes.ply.size() == hexes.size() && hexes.tow.size() == hexes.size();
   for (const auto& b : s.blocks<fem::Hex8Block>()) {
-    const int material = model.parts[static_cast<std::size_t>(b.part)].material;
+    const int material = b.material_index;
     for (std::size_t e = 0; e < b.n; ++e) {
       for (int I = 0; I < 8; ++I) m.hex8.push_back(b.conn[static_cast<std::size_t>(I) * b.n + e]);
       m.hex_part.push_back(b.part);

@@ -19,6 +19,9 @@ class RunHistory {
   RunHistory(std::filesystem::path file, MeasureList& measures, bool keep_rows);
   /// Appends a row at the solver's current state.
   void write_row(const fem::ExplicitSolver& s);
+  /// At the end of the run: the measures' final columns (RunMeasure::add_final_columns); when
+  /// there are any, history.csv is rewritten atomically with them.
+  void finish();
 
   const std::vector<std::string>& columns() const { return columns_; }
   /// Index of a column, -1 when absent.

@@ -9,6 +9,7 @@
 #include "drape/probes/picture_frame_force.hpp"
 #include "drape/probes/ring_shear_probe.hpp"
 #include "drape/probes/shear_angle_probe.hpp"
+#include "impact/crush_measure.hpp"
 
 namespace ncfsim::workflow {
 
@@ -169,6 +170,7 @@ MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s
   for (const auto& bp : ec.bending) m.push_back(std::make_unique<drape::BendingLengthMeasure>(bp, s));
   for (const auto& rp : ec.ring_probes) m.push_back(std::make_unique<drape::RingShearMeasure>(rp, s));
   if (auto curve = make_bias_extension_curve(ec)) m.push_back(std::move(curve));
+  if (ec.crush.enabled) m.push_back(std::make_unique<impact::CrushMeasure>(s, ec.crush.punch, ec.crush.cfc));
   m.push_back(std::make_unique<ContactResultants>());
   if (!ec.fabric_summaries.empty()) m.push_back(std::make_unique<drape::FabricReport>(ec.fabric_summaries, model));
   // After the report, which writes each fabric's summary entry anew.

@@ -106,8 +106,21 @@ void write_results(const std::filesystem::path& dir, const ImpregnatedModel& m) 
   scalar("E1_Pa", [&](std::size_t e) { return cls(e).elastic.E1; });
   scalar("E2_Pa", [&](std::size_t e) { return cls(e).elastic.E2; });
   scalar("G12_Pa", [&](std::size_t e) { return cls(e).elastic.G12; });
+  // The rest of the impregnated tow's constants, so that the crush builds its materials from
+  // this file alone (docs/output.md).
+  scalar("density_kg_m3", [&](std::size_t e) { return cls(e).density; });
+  scalar("E3_Pa", [&](std::size_t e) { return cls(e).elastic.E3; });
+  scalar("nu12", [&](std::size_t e) { return cls(e).elastic.nu12; });
+  scalar("nu13", [&](std::size_t e) { return cls(e).elastic.nu13; });
+  scalar("nu23", [&](std::size_t e) { return cls(e).elastic.nu23; });
+  scalar("G13_Pa", [&](std::size_t e) { return cls(e).elastic.G13; });
+  scalar("G23_Pa", [&](std::size_t e) { return cls(e).elastic.G23; });
   scalar("Xt_Pa", [&](std::size_t e) { return cls(e).strength.Xt; });
   scalar("Xc_Pa", [&](std::size_t e) { return cls(e).strength.Xc; });
+  scalar("Yt_Pa", [&](std::size_t e) { return cls(e).strength.Yt; });
+  scalar("Yc_Pa", [&](std::size_t e) { return cls(e).strength.Yc; });
+  scalar("S12_Pa", [&](std::size_t e) { return cls(e).strength.S12; });
+  scalar("S23_Pa", [&](std::size_t e) { return cls(e).strength.S23; });
   fem::io::XdmfResultWriter w(dir, rm);
   w.write_frame(fr);
   w.close();
