@@ -2,6 +2,9 @@
 // and [figures]. Every module reads and range-checks its own sections; docs/architecture.md.
 #include "workflow/case/engine_case.hpp"
 
+#include <algorithm>
+#include <limits>
+
 #include "drape/case/drape_case.hpp"
 #include "fem/case/case_context.hpp"
 #include "fem/case/fem_case.hpp"
@@ -76,6 +79,13 @@ void read_output(const CaseReadContext& ctx, EngineCase& ec) {
   ec.output.report = o->boolean("report", false);
   for (const auto& t : o->tables("probe"))
     ec.probes.push_back({t.string("name"), fem::select_nodes(ctx, t, "nodes")});
+  const auto& hexes = ctx.model.mesh.elements(fem::ElementKind::Hex8);
+  for (const auto& t : o->tables("element")) {
+    ElementProbe ep{t.string("name"), t.integer("element", 1, std::numeric_limits<std::int64_t>::max())};
+    if (std::find(hexes.user_id.begin(), hexes.user_id.end(), ep.element) == hexes.user_id.end())
+      t.fail("element", "no hexahedron has the id " + std::to_string(ep.element));
+    ec.element_probes.push_back(ep);
+  }
   ec.shear_probes = drape::read_shear_probes(ctx, *o);
   ec.ring_probes = drape::read_ring_shear_probes(ctx, *o);
   for (const auto& t : o->tables("mean")) ec.means.push_back(read_mean(t));

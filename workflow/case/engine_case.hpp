@@ -27,6 +27,14 @@ struct DisplacementProbe {
   std::vector<std::int32_t> nodes;
 };
 
+/// One hexahedron's stress and strain in its material axes (2nd Piola-Kirchhoff, Green-Lagrange,
+/// what the material law sees), written to history.csv as <name>_stress_<ij>_Pa and
+/// <name>_strain_<ij> (ij = 11 22 33 12 23 13, engineering shear strain).
+struct ElementProbe {
+  std::string name;
+  std::int64_t element = 0;  // user id
+};
+
 /// A named constraint set whose reaction goes to history.csv as <name>_reaction_{x,y,z}_N.
 struct ReactionProbe {
   std::string name;
@@ -111,6 +119,7 @@ struct EngineCase {
   fem::Model model;
   std::vector<DisplacementProbe> probes;
   std::vector<ReactionProbe> reactions;
+  std::vector<ElementProbe> element_probes;
   OutputSettings output;
   std::vector<PlotSpec> plots;
   std::vector<PictureSpec> pictures;

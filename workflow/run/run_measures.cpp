@@ -9,6 +9,7 @@
 #include "drape/probes/picture_frame_force.hpp"
 #include "drape/probes/ring_shear_probe.hpp"
 #include "drape/probes/shear_angle_probe.hpp"
+#include "fem/elements/hex8_block.hpp"
 #include "impact/crush_measure.hpp"
 
 namespace ncfsim::workflow {
@@ -117,6 +118,29 @@ class DisplacementMeasure final : public fem::RunMeasure {
   DisplacementProbe p_;
 };
 
+// One hexahedron's material-frame stress and strain.
+class ElementMeasure final : public fem::RunMeasure {
+ public:
+  ElementMeasure(const ElementProbe& p, const fem::ExplicitSolver& s) : p_(p) {
+    for (const auto& b : s.blocks<fem::Hex8Block>())
+      for (std::size_t e = 0; e < b.n; ++e)
+        if (b.user_id[e] == p.element) block_ = &b, index_ = e;
+  }
+  void add_columns(std::vector<std::string>& c) override {
+    for (const char* ij : {"11", "22", "33", "12", "23", "13"}) c.push_back(p_.name + "_stress_" + ij + "_Pa");
+    for (const char* ij : {"11", "22", "33", "12", "23", "13"}) c.push_back(p_.name + "_strain_" + ij);
+  }
+  void add_values(const fem::ExplicitSolver&, std::vector<double>& row) const override {
+    for (int c = 0; c < 6; ++c) row.push_back(block_ ? block_->stress[static_cast<std::size_t>(c) * block_->n + index_] : 0.0);
+    for (int c = 0; c < 6; ++c) row.push_back(block_ ? block_->strain[static_cast<std::size_t>(c) * block_->n + index_] : 0.0);
+  }
+
+ private:
+  ElementProbe p_;
+  const fem::Hex8Block* block_ = nullptr;
+  std::size_t index_ = 0;
+};
+
 // Force resultants of the deformable contacts, named by the contacts once they have run a cycle.
 class ContactResultants final : public fem::RunMeasure {
  public:
@@ -166,6 +190,7 @@ MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s
   for (std::size_t k = 0; k < model.picture_frames.size(); ++k)
     m.push_back(std::make_unique<drape::PictureFrameForce>(k, model.picture_frames[k], ec.frame_fabric_length[k]));
   for (const auto& p : ec.probes) m.push_back(std::make_unique<DisplacementMeasure>(p));
+  for (const auto& p : ec.element_probes) m.push_back(std::make_unique<ElementMeasure>(p, s));
   for (const auto& sp : ec.shear_probes) m.push_back(std::make_unique<drape::ShearAngleProbe>(sp, s, ec.file.string()));
   for (const auto& bp : ec.bending) m.push_back(std::make_unique<drape::BendingLengthMeasure>(bp, s));
   for (const auto& rp : ec.ring_probes) m.push_back(std::make_unique<drape::RingShearMeasure>(rp, s));
