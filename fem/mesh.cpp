@@ -17,7 +17,8 @@ void ElementSet::add(std::span<const std::int32_t> element_nodes, int part_index
 }
 
 ElementSet& Mesh::elements(ElementKind kind) {
-  auto it = std::find_if(sets.begin(), sets.end(), [&](const ElementSet& s) { return s.kind >= kind; });
+  auto it =
+      std::find_if(sets.begin(), sets.end(), [&](const ElementSet& s) { return s.kind >= kind; });
   if (it != sets.end() && it->kind == kind) return *it;
   ElementSet s;
   s.kind = kind;
@@ -83,7 +84,8 @@ void Mesh::fill_default_user_ids() {
 
 void Mesh::validate() const {
   const auto n = static_cast<std::int64_t>(n_nodes());
-  if (coords.size() % 3 != 0) throw std::invalid_argument("coordinate array is not a multiple of 3");
+  if (coords.size() % 3 != 0)
+    throw std::invalid_argument("coordinate array is not a multiple of 3");
   const auto n_parts = static_cast<std::int32_t>(part_names.size());
   for (std::size_t k = 0; k < sets.size(); ++k) {
     const ElementSet& s = sets[k];
@@ -93,7 +95,8 @@ void Mesh::validate() const {
     if (s.nodes_per_element != nodes_per_element(s.kind) ||
         s.conn.size() != s.size() * static_cast<std::size_t>(s.nodes_per_element))
       throw std::invalid_argument("part tag count differs from element count");
-    if ((!s.ply.empty() && s.ply.size() != s.size()) || (!s.tow.empty() && s.tow.size() != s.size()))
+    if ((!s.ply.empty() && s.ply.size() != s.size()) ||
+        (!s.tow.empty() && s.tow.size() != s.size()))
       throw std::invalid_argument("ply/tow tag count differs from the " + noun + " count");
     for (std::size_t e = 0; e < s.size(); ++e) {
       const auto nodes = s.nodes(e);
@@ -123,7 +126,8 @@ std::uint64_t spread_bits(std::uint64_t v) {  // 21 bits -> every third bit
   return v;
 }
 
-std::vector<std::uint64_t> morton_keys(const Mesh& m, const ElementSet& s, const std::array<double, 3>& lo,
+std::vector<std::uint64_t> morton_keys(const Mesh& m, const ElementSet& s,
+                                       const std::array<double, 3>& lo,
                                        const std::array<double, 3>& span) {
   const auto nn = static_cast<std::size_t>(s.nodes_per_element);
   std::vector<std::uint64_t> keys(s.size());
@@ -232,9 +236,10 @@ void append_grid_hexes(Mesh& mesh, int part, std::int32_t first, const std::arra
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
-        hexes.add({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                   id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)},
-                  part);
+        hexes.add(
+            {id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1),
+             id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)},
+            part);
       }
 }
 

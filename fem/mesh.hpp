@@ -51,7 +51,7 @@ struct ElementSet {
 };
 
 struct Mesh {
-  std::vector<double> coords;  // reference coordinates [3*n_nodes], xyz interleaved
+  std::vector<double> coords;    // reference coordinates [3*n_nodes], xyz interleaved
   std::vector<ElementSet> sets;  // at most one per kind, in ElementKind order (see elements())
   std::vector<std::string> part_names;
   std::vector<std::int64_t> node_user_id;  // id for messages (defaults to 1-based input order)
@@ -80,7 +80,9 @@ struct Mesh {
   void fill_default_user_ids();
   /// Throws std::invalid_argument naming the first inconsistency (bad node index, bad part).
   void validate() const;
-  std::array<double, 3> node(std::size_t i) const { return {coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]}; }
+  std::array<double, 3> node(std::size_t i) const {
+    return {coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]};
+  }
 };
 
 /// Reorders elements along a Morton curve of their centroids and renumbers nodes by first use.

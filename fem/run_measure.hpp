@@ -9,10 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "fem/solver.hpp"
 #include "fem/vec3.hpp"
@@ -45,7 +44,9 @@ class RunMeasure {
   }
   /// Appends its values at a history row: one per column it added (add_columns, then
   /// add_late_columns), in the same order. `row` holds the values of the measures before it.
-  virtual void add_values(const ExplicitSolver& s, std::vector<double>& row) const { (void)s, (void)row; }
+  virtual void add_values(const ExplicitSolver& s, std::vector<double>& row) const {
+    (void)s, (void)row;
+  }
   /// Whether it adds columns computed from the whole history once the run has ended
   /// (add_final_columns): the run then keeps every history row.
   virtual bool needs_final_columns() const { return false; }
@@ -58,18 +59,25 @@ class RunMeasure {
   }
   /// After a cycle in which hexahedra were eroded (the erosions are logged before): warning lines
   /// of what the measure saw change (e.g. stitch joints released).
-  virtual std::vector<std::string> after_erosion(const ExplicitSolver& s) { (void)s; return {}; }
+  virtual std::vector<std::string> after_erosion(const ExplicitSolver& s) {
+    (void)s;
+    return {};
+  }
   /// Writes its summary.json entries at the solver's current state (called at every frame and
   /// once at the end). A value that could not be measured is null.
-  virtual void add_summary(const ExplicitSolver& s, nlohmann::json& summary) const { (void)s, (void)summary; }
+  virtual void add_summary(const ExplicitSolver& s, nlohmann::json& summary) const {
+    (void)s, (void)summary;
+  }
   /// At every result frame: cell fields of its own. Several measures may fill one field (one
   /// fabric each): a measure adds the field if it is not there yet and fills its own cells.
-  virtual void add_frame_fields(const ExplicitSolver& s, std::vector<MeasureCellField>& fields) const {
+  virtual void add_frame_fields(const ExplicitSolver& s,
+                                std::vector<MeasureCellField>& fields) const {
     (void)s, (void)fields;
   }
   /// Once at the end of the run: files of its own in the output folder (written atomically),
   /// e.g. a drape's ring_shear.csv. Returns the file names it wrote.
-  virtual std::vector<std::string> write_files(const ExplicitSolver& s, const std::filesystem::path& dir) const {
+  virtual std::vector<std::string> write_files(const ExplicitSolver& s,
+                                               const std::filesystem::path& dir) const {
     (void)s, (void)dir;
     return {};
   }

@@ -1,9 +1,9 @@
 #include "fem/solver.hpp"
 
 #include <algorithm>
-#include <map>
 #include <array>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <utility>
 
@@ -102,7 +102,8 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
     std::copy(mesh.coords.begin(), mesh.coords.end(), X.data());
   }
   build_blocks();
-  for (const auto& g : groups_) material_failure_ = material_failure_ || (g->can_erode() && g->material_can_fail());
+  for (const auto& g : groups_)
+    material_failure_ = material_failure_ || (g->can_erode() && g->material_can_fail());
   assemble_mass();
   {  // gravity acts on the physical mass only: mass scaling adds inertia, not weight
     auto M = mass.view();
@@ -127,7 +128,8 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
     const auto& pv = model_.velocities[k];
     for (auto node : pv.nodes)
       for (int c = 0; c < 3; ++c)
-        if (pv.dofs[c]) fixed_mask_[3 * static_cast<std::size_t>(node) + c] = static_cast<std::uint8_t>(2 + k);
+        if (pv.dofs[c])
+          fixed_mask_[3 * static_cast<std::size_t>(node) + c] = static_cast<std::uint8_t>(2 + k);
   }
   build_motions();
   zero_.assign(3 * n, 0.0);
@@ -158,7 +160,8 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   step_ = s;
   dt_ = model_.time.safety_factor * s.dt;
   if (!(dt_ > 0) || !std::isfinite(dt_))
-    throw InputError("", "mesh", "no finite stable time step (element " + std::to_string(s.element) + ")");
+    throw InputError("", "mesh",
+                     "no finite stable time step (element " + std::to_string(s.element) + ")");
 
   for (auto& tool : model_.tools) {
     if (tool.motion.kind == ToolMotion::Kind::Force && !(tool.motion.mass > 0))
@@ -205,7 +208,8 @@ void ExplicitSolver::build_blocks() {
   std::vector<int> kind_of_part(model_.parts.size(), -1);
   for (const ElementSet& set : mesh.sets) {
     std::vector<std::vector<std::size_t>> of_part(model_.parts.size());
-    for (std::size_t e = 0; e < set.size(); ++e) of_part[static_cast<std::size_t>(set.part[e])].push_back(e);
+    for (std::size_t e = 0; e < set.size(); ++e)
+      of_part[static_cast<std::size_t>(set.part[e])].push_back(e);
     for (std::size_t p = 0; p < of_part.size(); ++p) {
       if (of_part[p].empty()) continue;
       if (kind_of_part[p] >= 0)
@@ -215,7 +219,8 @@ void ExplicitSolver::build_blocks() {
                              element_noun(set.kind) + " elements");
       kind_of_part[p] = static_cast<int>(set.kind);
       if (set.material.empty()) {
-        groups_.push_back(make_element_group(model_, set, static_cast<int>(p), of_part[p], X.data()));
+        groups_.push_back(
+            make_element_group(model_, set, static_cast<int>(p), of_part[p], X.data()));
         continue;
       }
       // Elements with their own material: one group per material of the part (batches of one law).
@@ -241,8 +246,10 @@ void ExplicitSolver::build_motions() {
   for (std::size_t m = 0; m < motions_.size(); ++m)
     for (std::size_t k = 0; k < motions_[m]->n_driven_sets(); ++k)
       for (auto node : motions_[m]->driven_nodes(k)) {
-        owner[static_cast<std::size_t>(node)] = {static_cast<std::int32_t>(m), static_cast<std::int32_t>(k)};
-        for (int c = 0; c < 3; ++c) fixed_mask_[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)] = 254;
+        owner[static_cast<std::size_t>(node)] = {static_cast<std::int32_t>(m),
+                                                 static_cast<std::int32_t>(k)};
+        for (int c = 0; c < 3; ++c)
+          fixed_mask_[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)] = 254;
       }
   for (std::size_t d = 0; d < 3 * n; ++d)
     if (fixed_mask_[d]) constrained_.push_back(d);
@@ -258,14 +265,17 @@ void ExplicitSolver::build_motions() {
   for (const auto& m : motions_) has_motion_forces_ = has_motion_forces_ || m->has_forces();
 }
 
-double ExplicitSolver::frame_wall_power(std::size_t k) const { return frames_ ? frames_->wall_power(k) : 0.0; }
+double ExplicitSolver::frame_wall_power(std::size_t k) const {
+  return frames_ ? frames_->wall_power(k) : 0.0;
+}
 std::int64_t ExplicitSolver::frame_wall_contacts(std::size_t k) const {
   return frames_ ? frames_->wall_contacts(k) : 0;
 }
 
 void ExplicitSolver::apply_mass_scaling() {
   auto X = x.view();
-  for (auto& g : groups_) g->scale_mass(X.data(), model_.time.mass_scaling_dt, model_.time.safety_factor);
+  for (auto& g : groups_)
+    g->scale_mass(X.data(), model_.time.mass_scaling_dt, model_.time.safety_factor);
 }
 
 std::string ExplicitSolver::element_position(const StableStep& st, const double* x) const {
@@ -278,7 +288,8 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
   for (const auto& g : groups_)
     if (g->kind() == st.kind)
       for (std::size_t e = 0; e < g->size(); ++e)
-        if (g->user_id(e) == st.element) return centre(g->conn(), g->size(), e, g->nodes_per_element());
+        if (g->user_id(e) == st.element)
+          return centre(g->conn(), g->size(), e, g->nodes_per_element());
   return "(unknown position)";
 }
 
@@ -308,18 +319,19 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bo
         continue;
       }
       using Cause = ErosionEvent::Cause;
-      const ErosionEvent ev{broken ? Cause::MaterialFailure
-                                   : (folded ? Cause::InvertedCorner : Cause::StableStep),
-                            t_,
-                            cycle_,
-                            g.user_id(e),
-                            g.kind(),
-                            g.part(),
-                            sf * dt,
-                            centroid(g.conn(), g.size(), e, nn, x)};
+      const ErosionEvent ev{
+          broken ? Cause::MaterialFailure : (folded ? Cause::InvertedCorner : Cause::StableStep),
+          t_,
+          cycle_,
+          g.user_id(e),
+          g.kind(),
+          g.part(),
+          sf * dt,
+          centroid(g.conn(), g.size(), e, nn, x)};
       ErodedForce& ef = eroded_forces_.emplace_back();
       ef.n_nodes = nn;
-      for (int I = 0; I < nn; ++I) ef.node[I] = g.conn()[static_cast<std::size_t>(I) * g.size() + e];
+      for (int I = 0; I < nn; ++I)
+        ef.node[I] = g.conn()[static_cast<std::size_t>(I) * g.size() + e];
       g.element_force(e, x, v, ef.f);
       energy_.eroded_internal += g.erode(e);
       gone.push_back(static_cast<std::int32_t>(offset + static_cast<std::size_t>(g.set_index(e))));
@@ -347,7 +359,8 @@ void ExplicitSolver::assemble_mass() {
       }
   }
   part_mass_.assign(model_.parts.size(), {});
-  for (std::size_t p = 0; p < part_mass_.size(); ++p) part_mass_[p].part = model_.mesh.part_names[p];
+  for (std::size_t p = 0; p < part_mass_.size(); ++p)
+    part_mass_[p].part = model_.mesh.part_names[p];
   for (const auto& g : groups_) {
     auto& pm = part_mass_[static_cast<std::size_t>(g->part())];
     g->add_part_mass(pm.mass, pm.added_mass);
@@ -385,209 +398,215 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   auto t0 = Clock::now();
   double dt_new = 0;
   {  // views are released before the callback, which may read the vectors itself
-  auto X = x.view();
-  auto Vv = v.view();
-  auto M = mass.view();
-  auto Fi = f_int.view();
-  auto Fe = f_ext.view();
-  auto Fc = f_contact.view();
-  auto Fd = f_damp.view();
-  auto Rr = reaction.view();
-  double* fi = Fi.data();
-  // Arrays a model does not use stay zero and are neither cleared nor read in the node loop.
-  const bool has_ext = !model_.loads.empty() || model_.gravity.x != 0 || model_.gravity.y != 0 || model_.gravity.z != 0;
-  const bool has_contact = !model_.tools.empty() || !model_.contacts.empty() || has_motion_forces_;
-  const bool has_damp = model_.mass_damping != 0 &&
-                        (model_.mass_damping_end_time <= 0 || t_ < model_.mass_damping_end_time);
-  std::fill(fi, fi + nd, 0.0);
-  if (has_ext) std::fill(Fe.data(), Fe.data() + nd, 0.0);
-  if (has_contact) std::fill(Fc.data(), Fc.data() + nd, 0.0);
+    auto X = x.view();
+    auto Vv = v.view();
+    auto M = mass.view();
+    auto Fi = f_int.view();
+    auto Fe = f_ext.view();
+    auto Fc = f_contact.view();
+    auto Fd = f_damp.view();
+    auto Rr = reaction.view();
+    double* fi = Fi.data();
+    // Arrays a model does not use stay zero and are neither cleared nor read in the node loop.
+    const bool has_ext = !model_.loads.empty() || model_.gravity.x != 0 || model_.gravity.y != 0 ||
+                         model_.gravity.z != 0;
+    const bool has_contact =
+        !model_.tools.empty() || !model_.contacts.empty() || has_motion_forces_;
+    const bool has_damp = model_.mass_damping != 0 &&
+                          (model_.mass_damping_end_time <= 0 || t_ < model_.mass_damping_end_time);
+    std::fill(fi, fi + nd, 0.0);
+    if (has_ext) std::fill(Fe.data(), Fe.data() + nd, 0.0);
+    if (has_contact) std::fill(Fc.data(), Fc.data() + nd, 0.0);
 
-  // Internal forces at x^n from v^{n-1/2}.
-  ElementEnergyIncrement inc;
-  StableStep st;
-  {
-    auto X0 = x0.view();
-    const ElementCycleState cs{X.data(), Vv.data(), X0.data(), dt_prev_};
-    for (std::size_t k = 0; k < groups_.size(); ++k) {
-      group_step_[k] = StableStep{};
-      groups_[k]->internal_forces(cs, fi, inc, group_step_[k]);
+    // Internal forces at x^n from v^{n-1/2}.
+    ElementEnergyIncrement inc;
+    StableStep st;
+    {
+      auto X0 = x0.view();
+      const ElementCycleState cs{X.data(), Vv.data(), X0.data(), dt_prev_};
+      for (std::size_t k = 0; k < groups_.size(); ++k) {
+        group_step_[k] = StableStep{};
+        groups_[k]->internal_forces(cs, fi, inc, group_step_[k]);
+      }
     }
-  }
-  // Erosion: a step below the limit is seen at once; folded corners, which develop over many
-  // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
-  // A failed material point (damage laws) is eroded in the cycle it fails.
-  const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
-  if (dt_erode > 0 || material_failure_) {
-    bool check_steps = false;
-    if (dt_erode > 0) {
-      StableStep erodible;
-      for (std::size_t k = 0; k < groups_.size(); ++k)
-        if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
-      check_steps = model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0;
+    // Erosion: a step below the limit is seen at once; folded corners, which develop over many
+    // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
+    // A failed material point (damage laws) is eroded in the cycle it fails.
+    const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
+    if (dt_erode > 0 || material_failure_) {
+      bool check_steps = false;
+      if (dt_erode > 0) {
+        StableStep erodible;
+        for (std::size_t k = 0; k < groups_.size(); ++k)
+          if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
+        check_steps =
+            model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0;
+      }
+      erode(X.data(), Vv.data(), dt_erode, check_steps);
     }
-    erode(X.data(), Vv.data(), dt_erode, check_steps);
-  }
-  for (const auto& s : group_step_) take_smaller(st, s);
-  energy_.internal += inc.internal;
-  energy_.stabilisation += inc.stabilisation;
-  energy_.hourglass += inc.hourglass;
-  step_ = st;
-  dt_new = model_.time.safety_factor * st.dt;
-  if (dt_prev_ > 0) dt_new = std::min(dt_new, 1.1 * dt_prev_);  // limit step growth
-  timers_.internal_force += seconds_since(t0);
+    for (const auto& s : group_step_) take_smaller(st, s);
+    energy_.internal += inc.internal;
+    energy_.stabilisation += inc.stabilisation;
+    energy_.hourglass += inc.hourglass;
+    step_ = st;
+    dt_new = model_.time.safety_factor * st.dt;
+    if (dt_prev_ > 0) dt_new = std::min(dt_new, 1.1 * dt_prev_);  // limit step growth
+    timers_.internal_force += seconds_since(t0);
 
-  // Contact with rigid tools at x^n.
-  t0 = Clock::now();
-  const double dt_c = dt_prev_ > 0 ? dt_prev_ : dt_new;
-  for (auto& tool : model_.tools) tool_contact_forces(tool, X.data(), Vv.data(), M.data(), dt_c, Fc.data());
-  for (auto& c : model_.contacts) {
-    c->add_forces(X.data(), Vv.data(), M.data(), dt_c, Fc.data());
-    dt_new = std::min(dt_new, c->stable_step_limit());
-  }
-  for (auto& m : motions_)
-    if (m->has_forces()) m->add_forces(t_, X.data(), M.data(), dt_c, Fc.data());
-  timers_.contact += seconds_since(t0);
-
-  // External forces at t^n, damping from v^{n-1/2}.
-  t0 = Clock::now();
-  for (const auto& ld : model_.loads) {
-    const V3 F = smooth_ramp(t_, ld.ramp_time) * ld.force_per_node;
-    for (auto node : ld.nodes) {
-      const auto i = static_cast<std::size_t>(node);
-      Fe[3 * i] += F.x, Fe[3 * i + 1] += F.y, Fe[3 * i + 2] += F.z;
+    // Contact with rigid tools at x^n.
+    t0 = Clock::now();
+    const double dt_c = dt_prev_ > 0 ? dt_prev_ : dt_new;
+    for (auto& tool : model_.tools)
+      tool_contact_forces(tool, X.data(), Vv.data(), M.data(), dt_c, Fc.data());
+    for (auto& c : model_.contacts) {
+      c->add_forces(X.data(), Vv.data(), M.data(), dt_c, Fc.data());
+      dt_new = std::min(dt_new, c->stable_step_limit());
     }
-  }
-  const V3 g = smooth_ramp(t_, model_.gravity_ramp_time) * model_.gravity;
-  if (g.x != 0 || g.y != 0 || g.z != 0)
-    for (std::size_t i = 0; i < n; ++i)
-      Fe[3 * i] += gravity_mass_[3 * i] * g.x, Fe[3 * i + 1] += gravity_mass_[3 * i + 1] * g.y,
-      Fe[3 * i + 2] += gravity_mass_[3 * i + 2] * g.z;
-  const double alpha = has_damp ? model_.mass_damping : 0.0;
+    for (auto& m : motions_)
+      if (m->has_forces()) m->add_forces(t_, X.data(), M.data(), dt_c, Fc.data());
+    timers_.contact += seconds_since(t0);
 
-  if (dt_new < model_.time.min_step_ratio * dt_initial_) {
-    std::ostringstream os;
-    os << "numerical instability: the stable time step fell to " << dt_new << " s ("
-       << dt_new / dt_initial_ << " of the initial " << dt_initial_ << " s) at t = " << t_
-       << " s, cycle " << cycle_ << "; controlled by " << element_noun(st.kind) << " "
-       << st.element << " at " << element_position(st, X.data())
-       << " (severely distorted or inverted)";
-    throw NumericalError(os.str());
-  }
-
-  // Prescribed velocities at t^{n+1/2}.
-  const double t_half = t_ + 0.5 * dt_new;
-  std::vector<V3>& vpres = vpres_;
-  for (std::size_t k = 0; k < vpres.size(); ++k)
-    vpres[k] = smooth_ramp(t_half - model_.velocities[k].start_time, model_.velocities[k].ramp_time) *
-               model_.velocities[k].velocity;
-
-  // v^{n+1/2}; works of each force kind over the increments around t^n.
-  const double dt_mid = 0.5 * (dt_prev_ + dt_new);
-  // Without a callback the position update joins this loop (one pass over the nodal arrays).
-  double* xfused = at_tn ? nullptr : X.data();
-  const double* inv_m = inv_mass_.data();
-  const double* fe = has_ext ? Fe.data() : zero_.data();
-  const double* fcon = has_contact ? Fc.data() : zero_.data();
-  double* fdamp = Fd.data();
-  double* rr = Rr.data();
-  double* vel = Vv.data();
-  const double* mm = M.data();
-  // Constrained DOFs keep their v^{n-1/2} aside: the free update below runs over every DOF
-  // without branches (it vectorises), then those DOFs are corrected.
-  for (std::size_t k = 0; k < constrained_.size(); ++k) constrained_vo_[k] = vel[constrained_[k]];
-  const double dtp = dt_prev_;
-  // Without damping this cycle f_damp is left alone by the pass, so it is cleared once here.
-  if (alpha == 0 && !f_damp_zero_) std::fill(fdamp, fdamp + nd, 0.0);
-  f_damp_zero_ = alpha == 0;
-  const std::size_t kind =
-      (xfused ? 8 : 0) + (has_ext ? 4 : 0) + (has_contact ? 2 : 0) + (alpha != 0 ? 1 : 0);
-  auto [ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke] =
-      kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused);
-  // Works over the increments du_old = dt_prev v^{n-1/2}, du_new = dt_new v^{n+1/2}; kinetic energy
-  // in product form: with the trapezoidal works, 1/2 v^{n-1/2} M v^{n+1/2} makes the discrete
-  // energy balance of central differences exact for conservative forces.
-  ext_old *= dtp, ext_new *= dt_new, damp_old *= dtp, damp_new *= dt_new, con_old *= dtp, con_new *= dt_new;
-  ke *= 0.5;
-  const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
-  for (auto& m : motions_) m->velocities(t_half, motion_v_.data());
-  for (std::size_t k = 0; k < constrained_.size(); ++k) {
-    const std::size_t d = constrained_[k];
-    const std::uint8_t code = fixed_mask_[d];
-    const double vo = constrained_vo_[k], m = mm[d], vfree = vel[d];
-    double vp = 0.0;
-    if (code == 254) {
-      vp = motion_v_[k];
-    } else if (code > 1) {
-      vp = vpres[code - 2].arr()[d % 3];
+    // External forces at t^n, damping from v^{n-1/2}.
+    t0 = Clock::now();
+    for (const auto& ld : model_.loads) {
+      const V3 F = smooth_ramp(t_, ld.ramp_time) * ld.force_per_node;
+      for (auto node : ld.nodes) {
+        const auto i = static_cast<std::size_t>(node);
+        Fe[3 * i] += F.x, Fe[3 * i + 1] += F.y, Fe[3 * i + 2] += F.z;
+      }
     }
-    const double r = m * (vp - vfree) * inv_dt_mid;
-    rr[d] = r;
-    vel[d] = vp;
-    const double dv = vp - vfree;
-    if (xfused) xfused[d] += dt_new * dv;
-    ext_old += r * dtp * vo;
-    ext_new += fe[d] * dt_new * dv + r * dt_new * vp;
-    damp_new += fdamp[d] * dt_new * dv;
-    con_new += fcon[d] * dt_new * dv;
-    ke += 0.5 * m * vo * dv;
-  }
-  w_ext_.add(ext_old, ext_new);
-  for (const auto& ef : eroded_forces_)  // see ErodedForce
-    for (int I = 0; I < ef.n_nodes; ++I)
-      for (int c = 0; c < 3; ++c)
-        energy_.internal +=
-            0.5 * ef.f[3 * I + c] * dt_new * vel[3 * static_cast<std::size_t>(ef.node[I]) + c];
-  eroded_forces_.clear();
-  w_damp_.add(damp_old, damp_new);
-  w_contact_nodes_.add(con_old, con_new);
+    const V3 g = smooth_ramp(t_, model_.gravity_ramp_time) * model_.gravity;
+    if (g.x != 0 || g.y != 0 || g.z != 0)
+      for (std::size_t i = 0; i < n; ++i)
+        Fe[3 * i] += gravity_mass_[3 * i] * g.x, Fe[3 * i + 1] += gravity_mass_[3 * i + 1] * g.y,
+            Fe[3 * i + 2] += gravity_mass_[3 * i + 2] * g.z;
+    const double alpha = has_damp ? model_.mass_damping : 0.0;
 
-  // Tools: velocity over the next half step, and their work.
-  double tool_on_nodes_old = 0, tool_on_nodes_new = 0, tool_src_old = 0, tool_src_new = 0;
-  for (auto& tool : model_.tools) {
-    const V3 vo = tool.velocity;
-    V3 vn;
-    if (tool.motion.kind == ToolMotion::Kind::Velocity) {
-      vn = tool_prescribed_velocity(tool, t_half);
-    } else if (tool.motion.kind == ToolMotion::Kind::Force) {
-      const V3 ax = tool.motion.axis;
-      const double a = (tool.motion.force + dot(tool.force, ax)) / tool.motion.mass;
-      vn = (dot(vo, ax) + dt_mid * a) * ax;
-      ke += 0.5 * tool.motion.mass * dot(vo, vn);
+    if (dt_new < model_.time.min_step_ratio * dt_initial_) {
+      std::ostringstream os;
+      os << "numerical instability: the stable time step fell to " << dt_new << " s ("
+         << dt_new / dt_initial_ << " of the initial " << dt_initial_ << " s) at t = " << t_
+         << " s, cycle " << cycle_ << "; controlled by " << element_noun(st.kind) << " "
+         << st.element << " at " << element_position(st, X.data())
+         << " (severely distorted or inverted)";
+      throw NumericalError(os.str());
     }
-    tool.velocity = vn;
-    // The tool pushes the nodes with -tool.force.
-    tool_on_nodes_old += -dot(tool.force, dt_prev_ * vo);
-    tool_on_nodes_new += -dot(tool.force, dt_new * vn);
-    if (tool.motion.kind == ToolMotion::Kind::Velocity) {
-      tool_src_old += -dot(tool.force, dt_prev_ * vo);
-      tool_src_new += -dot(tool.force, dt_new * vn);
-    } else if (tool.motion.kind == ToolMotion::Kind::Force) {
-      const V3 F = tool.motion.force * tool.motion.axis;
-      tool_src_old += dot(F, dt_prev_ * vo);
-      tool_src_new += dot(F, dt_new * vn);
-    }
-  }
-  // Rigs' walls: driven like velocity tools, so their work on the nodes is the rig's (external)
-  // work; the contact energy keeps the penalty energy stored.
-  for (auto& m : motions_)
-    if (m->has_forces())
-      m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, tool_src_old, tool_src_new,
-                        tool_on_nodes_old, tool_on_nodes_new);
-  w_tools_.add(tool_src_old, tool_src_new);
-  tool_work_on_nodes_.add(tool_on_nodes_old, tool_on_nodes_new);
 
-  energy_.time = t_;
-  energy_.kinetic = ke;
-  energy_.external_work = w_ext_.committed + w_tools_.committed;
-  energy_.damping = -w_damp_.committed;
-  energy_.contact = tool_work_on_nodes_.committed - w_contact_nodes_.committed;
-  double fr = 0;
-  for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
-  for (const auto& c : model_.contacts) fr += c->friction_dissipation();
-  energy_.friction = fr;
-  if (!std::isfinite(ke)) check_finite(Vv.data());
-  timers_.update += seconds_since(t0);
+    // Prescribed velocities at t^{n+1/2}.
+    const double t_half = t_ + 0.5 * dt_new;
+    std::vector<V3>& vpres = vpres_;
+    for (std::size_t k = 0; k < vpres.size(); ++k)
+      vpres[k] =
+          smooth_ramp(t_half - model_.velocities[k].start_time, model_.velocities[k].ramp_time) *
+          model_.velocities[k].velocity;
+
+    // v^{n+1/2}; works of each force kind over the increments around t^n.
+    const double dt_mid = 0.5 * (dt_prev_ + dt_new);
+    // Without a callback the position update joins this loop (one pass over the nodal arrays).
+    double* xfused = at_tn ? nullptr : X.data();
+    const double* inv_m = inv_mass_.data();
+    const double* fe = has_ext ? Fe.data() : zero_.data();
+    const double* fcon = has_contact ? Fc.data() : zero_.data();
+    double* fdamp = Fd.data();
+    double* rr = Rr.data();
+    double* vel = Vv.data();
+    const double* mm = M.data();
+    // Constrained DOFs keep their v^{n-1/2} aside: the free update below runs over every DOF
+    // without branches (it vectorises), then those DOFs are corrected.
+    for (std::size_t k = 0; k < constrained_.size(); ++k) constrained_vo_[k] = vel[constrained_[k]];
+    const double dtp = dt_prev_;
+    // Without damping this cycle f_damp is left alone by the pass, so it is cleared once here.
+    if (alpha == 0 && !f_damp_zero_) std::fill(fdamp, fdamp + nd, 0.0);
+    f_damp_zero_ = alpha == 0;
+    const std::size_t kind =
+        (xfused ? 8 : 0) + (has_ext ? 4 : 0) + (has_contact ? 2 : 0) + (alpha != 0 ? 1 : 0);
+    auto [ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke] =
+        kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused);
+    // Works over the increments du_old = dt_prev v^{n-1/2}, du_new = dt_new v^{n+1/2}; kinetic
+    // energy in product form: with the trapezoidal works, 1/2 v^{n-1/2} M v^{n+1/2} makes the
+    // discrete energy balance of central differences exact for conservative forces.
+    ext_old *= dtp, ext_new *= dt_new, damp_old *= dtp, damp_new *= dt_new, con_old *= dtp,
+        con_new *= dt_new;
+    ke *= 0.5;
+    const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
+    for (auto& m : motions_) m->velocities(t_half, motion_v_.data());
+    for (std::size_t k = 0; k < constrained_.size(); ++k) {
+      const std::size_t d = constrained_[k];
+      const std::uint8_t code = fixed_mask_[d];
+      const double vo = constrained_vo_[k], m = mm[d], vfree = vel[d];
+      double vp = 0.0;
+      if (code == 254) {
+        vp = motion_v_[k];
+      } else if (code > 1) {
+        vp = vpres[code - 2].arr()[d % 3];
+      }
+      const double r = m * (vp - vfree) * inv_dt_mid;
+      rr[d] = r;
+      vel[d] = vp;
+      const double dv = vp - vfree;
+      if (xfused) xfused[d] += dt_new * dv;
+      ext_old += r * dtp * vo;
+      ext_new += fe[d] * dt_new * dv + r * dt_new * vp;
+      damp_new += fdamp[d] * dt_new * dv;
+      con_new += fcon[d] * dt_new * dv;
+      ke += 0.5 * m * vo * dv;
+    }
+    w_ext_.add(ext_old, ext_new);
+    for (const auto& ef : eroded_forces_)  // see ErodedForce
+      for (int I = 0; I < ef.n_nodes; ++I)
+        for (int c = 0; c < 3; ++c)
+          energy_.internal +=
+              0.5 * ef.f[3 * I + c] * dt_new * vel[3 * static_cast<std::size_t>(ef.node[I]) + c];
+    eroded_forces_.clear();
+    w_damp_.add(damp_old, damp_new);
+    w_contact_nodes_.add(con_old, con_new);
+
+    // Tools: velocity over the next half step, and their work.
+    double tool_on_nodes_old = 0, tool_on_nodes_new = 0, tool_src_old = 0, tool_src_new = 0;
+    for (auto& tool : model_.tools) {
+      const V3 vo = tool.velocity;
+      V3 vn;
+      if (tool.motion.kind == ToolMotion::Kind::Velocity) {
+        vn = tool_prescribed_velocity(tool, t_half);
+      } else if (tool.motion.kind == ToolMotion::Kind::Force) {
+        const V3 ax = tool.motion.axis;
+        const double a = (tool.motion.force + dot(tool.force, ax)) / tool.motion.mass;
+        vn = (dot(vo, ax) + dt_mid * a) * ax;
+        ke += 0.5 * tool.motion.mass * dot(vo, vn);
+      }
+      tool.velocity = vn;
+      // The tool pushes the nodes with -tool.force.
+      tool_on_nodes_old += -dot(tool.force, dt_prev_ * vo);
+      tool_on_nodes_new += -dot(tool.force, dt_new * vn);
+      if (tool.motion.kind == ToolMotion::Kind::Velocity) {
+        tool_src_old += -dot(tool.force, dt_prev_ * vo);
+        tool_src_new += -dot(tool.force, dt_new * vn);
+      } else if (tool.motion.kind == ToolMotion::Kind::Force) {
+        const V3 F = tool.motion.force * tool.motion.axis;
+        tool_src_old += dot(F, dt_prev_ * vo);
+        tool_src_new += dot(F, dt_new * vn);
+      }
+    }
+    // Rigs' walls: driven like velocity tools, so their work on the nodes is the rig's (external)
+    // work; the contact energy keeps the penalty energy stored.
+    for (auto& m : motions_)
+      if (m->has_forces())
+        m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, tool_src_old, tool_src_new,
+                          tool_on_nodes_old, tool_on_nodes_new);
+    w_tools_.add(tool_src_old, tool_src_new);
+    tool_work_on_nodes_.add(tool_on_nodes_old, tool_on_nodes_new);
+
+    energy_.time = t_;
+    energy_.kinetic = ke;
+    energy_.external_work = w_ext_.committed + w_tools_.committed;
+    energy_.damping = -w_damp_.committed;
+    energy_.contact = tool_work_on_nodes_.committed - w_contact_nodes_.committed;
+    double fr = 0;
+    for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
+    for (const auto& c : model_.contacts) fr += c->friction_dissipation();
+    energy_.friction = fr;
+    if (!std::isfinite(ke)) check_finite(Vv.data());
+    timers_.update += seconds_since(t0);
   }
 
   if (at_tn) {

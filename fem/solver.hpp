@@ -134,9 +134,9 @@ class ExplicitSolver {
 
   Model& model_;
   std::vector<std::unique_ptr<ElementGroup>> groups_;
-  std::vector<StableStep> group_step_;  // per group, this cycle
+  std::vector<StableStep> group_step_;                    // per group, this cycle
   std::vector<std::unique_ptr<BoundaryMotion>> motions_;  // rigs that drive nodes (picture frames)
-  PictureFrameMotion* frames_ = nullptr;                   // among motions_
+  PictureFrameMotion* frames_ = nullptr;                  // among motions_
   std::vector<PartMassReport> part_mass_;
   std::vector<ErosionEvent> erosions_;
   bool material_failure_ = false;  // a group's material can fail elements
@@ -152,15 +152,15 @@ class ExplicitSolver {
   std::vector<ErodedForce> eroded_forces_;
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
-  std::vector<V3> vpres_;  // prescribed velocities at t^{n+1/2}, one per set
+  std::vector<V3> vpres_;         // prescribed velocities at t^{n+1/2}, one per set
   std::vector<double> motion_v_;  // per constrained DOF: velocity from its boundary motion
   bool has_motion_forces_ = false;
   std::vector<std::size_t> constrained_;  // DOFs with a fixed or prescribed velocity
   std::vector<double> constrained_vo_;    // their v^{n-1/2} during a cycle
   std::vector<double> zero_;              // [3*n] zeros for force arrays a model does not use
   bool f_damp_zero_ = false;              // f_damp holds zeros (no damping since it was cleared)
-  std::vector<double> inv_mass_;      // [3*n] 1 / lumped mass
-  std::vector<double> gravity_mass_;  // [3*n] physical nodal masses (no mass scaling)
+  std::vector<double> inv_mass_;          // [3*n] 1 / lumped mass
+  std::vector<double> gravity_mass_;      // [3*n] physical nodal masses (no mass scaling)
   std::int64_t cycle_ = 0;
   StableStep step_;
   EnergyBalance energy_;

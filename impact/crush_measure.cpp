@@ -49,8 +49,8 @@ std::vector<std::string> CrushMeasure::setup_lines() const {
   lines.push_back(fmt::format("crush: punch '{}', force filtered at CFC {:g} (column {})",
                               punch_name_, cfc_, filtered_column()));
   for (const auto* t : ties_)
-    lines.push_back(fmt::format("crush: resin bond '{}': {} tied nodes over {:.5g} mm^2",
-                                t->name(), t->n_ties(), 1e6 * t->tied_area()));
+    lines.push_back(fmt::format("crush: resin bond '{}': {} tied nodes over {:.5g} mm^2", t->name(),
+                                t->n_ties(), 1e6 * t->tied_area()));
   return lines;
 }
 
@@ -63,7 +63,8 @@ CrushMeasure::DamageCounts CrushMeasure::count_damage(const fem::ExplicitSolver&
   DamageCounts dc;
   for (auto k : damage_groups_) {
     const auto& b = *fem::block_of<fem::Hex8Block>(*s.groups()[k]);
-    const double* d = b.history.data() + static_cast<std::size_t>(TowDamageMaterial::kDamageRow) * b.n;
+    const double* d =
+        b.history.data() + static_cast<std::size_t>(TowDamageMaterial::kDamageRow) * b.n;
     dc.elements += b.n;
     for (int m = 0; m < kModes; ++m)
       for (std::size_t e = 0; e < b.n; ++e) {
@@ -90,10 +91,12 @@ void CrushMeasure::add_values(const fem::ExplicitSolver& s, std::vector<double>&
   std::size_t failed = 0;
   for (auto k : damage_groups_) {
     const auto& b = *fem::block_of<fem::Hex8Block>(*s.groups()[k]);
-    const double* d = b.history.data() + static_cast<std::size_t>(TowDamageMaterial::kDamageRow) * b.n;
+    const double* d =
+        b.history.data() + static_cast<std::size_t>(TowDamageMaterial::kDamageRow) * b.n;
     for (std::size_t e = 0; e < b.n; ++e) {
       double dmax = 0;
-      for (int m = 0; m < kModes; ++m) dmax = std::max(dmax, d[static_cast<std::size_t>(m) * b.n + e]);
+      for (int m = 0; m < kModes; ++m)
+        dmax = std::max(dmax, d[static_cast<std::size_t>(m) * b.n + e]);
       failed += dmax >= kFullDamage;
     }
   }
@@ -152,8 +155,10 @@ void CrushMeasure::add_summary(const fem::ExplicitSolver& s, nlohmann::json& sum
   std::size_t dominant = 0;
   for (int m = 0; m < kModes; ++m) {
     const auto k = static_cast<std::size_t>(m);
-    summary[std::string("failed_fraction_") + kModeNames[k]] = static_cast<double>(dc.failed[k]) / n;
-    summary[std::string("initiated_fraction_") + kModeNames[k]] = static_cast<double>(dc.initiated[k]) / n;
+    summary[std::string("failed_fraction_") + kModeNames[k]] =
+        static_cast<double>(dc.failed[k]) / n;
+    summary[std::string("initiated_fraction_") + kModeNames[k]] =
+        static_cast<double>(dc.initiated[k]) / n;
     if (dc.failed[k] > dc.failed[dominant]) dominant = k;
   }
   summary["dominant_failure_mode"] =
@@ -172,20 +177,23 @@ void CrushMeasure::add_summary(const fem::ExplicitSolver& s, nlohmann::json& sum
 void CrushMeasure::add_frame_fields(const fem::ExplicitSolver& s,
                                     std::vector<fem::MeasureCellField>& fields) const {
   std::size_t n_hex = 0, n_bar = 0;
-  for (const auto& g : s.groups()) (g->kind() == fem::ElementKind::Hex8 ? n_hex : n_bar) += g->size();
+  for (const auto& g : s.groups())
+    (g->kind() == fem::ElementKind::Hex8 ? n_hex : n_bar) += g->size();
   const std::size_t n_cells = n_hex + n_bar;
   std::vector<fem::MeasureCellField> out;
   for (int m = 0; m < kModes; ++m)
     out.push_back({std::string("damage_") + kModeNames[static_cast<std::size_t>(m)], 1,
                    std::vector<double>(n_cells, kNaN)});
-  // 0: no mode fully damaged; 1 + m: mode m (FailureMode order) is the most damaged of those that are.
+  // 0: no mode fully damaged; 1 + m: mode m (FailureMode order) is the most damaged of those that
+  // are.
   out.push_back({"failed_mode", 1, std::vector<double>(n_cells, kNaN)});
   std::size_t offset = 0;
   for (const auto& g : s.groups()) {
     if (g->kind() != fem::ElementKind::Hex8) continue;
     const auto& b = *fem::block_of<fem::Hex8Block>(*g);
     if (dynamic_cast<const TowDamageMaterial*>(b.material)) {
-      const double* d = b.history.data() + static_cast<std::size_t>(TowDamageMaterial::kDamageRow) * b.n;
+      const double* d =
+          b.history.data() + static_cast<std::size_t>(TowDamageMaterial::kDamageRow) * b.n;
       for (std::size_t e = 0; e < b.n; ++e) {
         int worst = -1;
         double dmax = 0;

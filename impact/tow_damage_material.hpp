@@ -63,7 +63,7 @@ struct TowDamageConstants {
 class TowDamageMaterial final : public fem::SolidMaterial {
  public:
   static constexpr int kHistory = 19;
-  static constexpr int kDamageRow = 12;   // d of mode m in row kDamageRow + m
+  static constexpr int kDamageRow = 12;  // d of mode m in row kDamageRow + m
   static constexpr int kFailedRow = 18;
   /// Throws std::invalid_argument naming the constant and its allowed range.
   TowDamageMaterial(std::string name, const TowDamageConstants& c);
@@ -84,7 +84,8 @@ class TowDamageMaterial final : public fem::SolidMaterial {
   TowDamageConstants c_;
   fem::Voigt6x6 C_{};
   std::array<double, kModes> strength_{}, modulus_{}, rf_length_{};
-  std::array<double, kModes> erode_{};  // 1: the mode's full damage fails the element  // per mode; rf = rf_length / L
+  std::array<double, kModes>
+      erode_{};  // 1: the mode's full damage fails the element  // per mode; rf = rf_length / L
 };
 
 }  // namespace ncfsim::impact

@@ -111,8 +111,8 @@ void check_starts_clear(const TableReader& t, const RigidTool& tool, const Mesh&
   const auto p = mesh.node(static_cast<std::size_t>(worst));
   std::ostringstream os;
   os << "tool '" << tool.name << "' starts inside the body it contacts: node "
-     << mesh.node_user_id[static_cast<std::size_t>(worst)] << " at (" << p[0] << ", " << p[1] << ", "
-     << p[2] << ") m is " << deepest * 1e3
+     << mesh.node_user_id[static_cast<std::size_t>(worst)] << " at (" << p[0] << ", " << p[1]
+     << ", " << p[2] << ") m is " << deepest * 1e3
      << " mm inside it; place the tool (point, radius) clear of its contact nodes";
   t.fail("point", os.str());
 }

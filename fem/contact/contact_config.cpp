@@ -23,7 +23,8 @@ void validate(const PenaltyContactConfig& c) {
   auto pair_key = [&](std::size_t p) {
     return from_case ? key("pair[" + std::to_string(p) + "]") : key("pairs");
   };
-  if (c.name.empty()) throw InputError(f, from_case ? key("name") : "contact.name", "a contact needs a name");
+  if (c.name.empty())
+    throw InputError(f, from_case ? key("name") : "contact.name", "a contact needs a name");
   if (c.groups.empty())
     throw InputError(f, groups_key, "a penalty contact needs at least one [[contact.group]]");
   for (std::size_t g = 0; g < c.groups.size(); ++g) {
@@ -36,7 +37,8 @@ void validate(const PenaltyContactConfig& c) {
       throw InputError(f, groups_key, "group '" + c.groups[g].name + "' lists no parts");
   }
   if (c.pairs.empty())
-    throw InputError(f, key(from_case ? "pair" : "pairs"), "a penalty contact needs at least one [[contact.pair]]");
+    throw InputError(f, key(from_case ? "pair" : "pairs"),
+                     "a penalty contact needs at least one [[contact.pair]]");
   const auto n_groups = static_cast<int>(c.groups.size());
   for (std::size_t p = 0; p < c.pairs.size(); ++p) {
     const auto& pr = c.pairs[p];
@@ -73,10 +75,13 @@ void validate(const TiedContactConfig& c) {
   const std::string& f = c.source_file;
   const bool from_case = !c.key_path.empty();
   auto key = [&](const std::string& field) { return key_of(c.key_path, c.name, field); };
-  if (c.name.empty()) throw InputError(f, from_case ? key("name") : "contact.name", "a tied contact needs a name");
+  if (c.name.empty())
+    throw InputError(f, from_case ? key("name") : "contact.name", "a tied contact needs a name");
   for (const ContactGroup* g : {&c.slave, &c.master})
     if (g->parts.empty() && c.face_pairs.empty())
-      throw InputError(f, key(g == &c.slave ? (from_case ? "slave_parts" : "slave") : (from_case ? "master_parts" : "master")),
+      throw InputError(f,
+                       key(g == &c.slave ? (from_case ? "slave_parts" : "slave")
+                                         : (from_case ? "master_parts" : "master")),
                        "lists no parts");
   for (int p : c.slave.parts)
     for (int q : c.master.parts)

@@ -6,7 +6,8 @@
 // initialise(), before the first cycle. Every check throws InputError(source_file, key, message)
 // naming the case-file key (key_path + ".<field>", e.g. "contact[0].pair[1].friction") or, for a
 // config built in code (key_path empty), "contact.<name>.<field>". These are the only range checks
-// of the [[contact]] keys: the case reader (fem/case) reads the values and leaves them to validate().
+// of the [[contact]] keys: the case reader (fem/case) reads the values and leaves them to
+// validate().
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -96,8 +97,8 @@ struct TiedContactConfig {
   /// Explicit face pairs (non-empty: slave and master groups are not used): each node of a slave
   /// face is tied to the nearest of the master faces paired with its faces.
   std::vector<TiedFacePair> face_pairs;
-  std::string source_file;     // for messages only, may be empty
-  std::string key_path;        // for messages only: the case-file table ("contact[1]"), may be empty
+  std::string source_file;  // for messages only, may be empty
+  std::string key_path;     // for messages only: the case-file table ("contact[1]"), may be empty
 };
 
 /// Range checks independent of the mesh; throw InputError naming the key, value and range.

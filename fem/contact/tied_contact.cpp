@@ -76,18 +76,22 @@ void TiedContact::initialise_face_pairs(const ContactSetup& setup) {
   const ElementSet& hexes = setup.mesh->elements(ElementKind::Hex8);
   const std::size_t offset = setup.mesh->element_offset(ElementKind::Hex8);
   const double* x0 = setup.x0;
-  auto face_nodes = [&](std::int32_t h, int f, std::int32_t (&c)[4]) {
+  auto face_nodes = [&](std::int32_t h, int f, std::int32_t(&c)[4]) {
     if (static_cast<std::size_t>(h) >= hexes.size())
       throw InputError(cfg_.source_file, prefix + ".face_pairs",
                        "names hexahedron index " + std::to_string(h) + " outside the mesh");
     const auto nodes = hexes.nodes(static_cast<std::size_t>(h));
-    for (int a = 0; a < 4; ++a) c[a] = nodes[static_cast<std::size_t>(kHex8Faces[static_cast<std::size_t>(f)].corner[static_cast<std::size_t>(a)])];
+    for (int a = 0; a < 4; ++a)
+      c[a] = nodes[static_cast<std::size_t>(
+          kHex8Faces[static_cast<std::size_t>(f)].corner[static_cast<std::size_t>(a)])];
   };
   // Slave faces (each once) give their nodes a quarter of their area; each slave node collects
   // the master faces paired with its faces.
   std::vector<std::pair<std::int64_t, std::size_t>> slave_faces;  // key -> first pair
   for (std::size_t k = 0; k < cfg_.face_pairs.size(); ++k)
-    slave_faces.emplace_back(6 * static_cast<std::int64_t>(cfg_.face_pairs[k].slave_hex) + cfg_.face_pairs[k].slave_face, k);
+    slave_faces.emplace_back(
+        6 * static_cast<std::int64_t>(cfg_.face_pairs[k].slave_hex) + cfg_.face_pairs[k].slave_face,
+        k);
   std::sort(slave_faces.begin(), slave_faces.end());
   struct Candidate {
     std::int32_t node;
@@ -108,7 +112,9 @@ void TiedContact::initialise_face_pairs(const ContactSetup& setup) {
       const double cx = d1[1] * d2[2] - d1[2] * d2[1], cy = d1[2] * d2[0] - d1[0] * d2[2],
                    cz = d1[0] * d2[1] - d1[1] * d2[0];
       const double a = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
-      for (auto nd : c) area[static_cast<std::size_t>(nd)] += 0.25 * a, hex_of[static_cast<std::size_t>(nd)] = p.slave_hex;
+      for (auto nd : c)
+        area[static_cast<std::size_t>(nd)] += 0.25 * a,
+            hex_of[static_cast<std::size_t>(nd)] = p.slave_hex;
     }
     for (auto nd : c) cand.push_back({nd, slave_faces[i].second});
   }
@@ -281,8 +287,12 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
       // Tractions from the bilinear law at this node's separations (K = k / area); the energy
       // the damage increment releases, 1/2 dd K dm^2 per area, is dissipated.
       const double A = area_[t];
-      const CohesiveLaw law{k / A, cfg_.normal_strength, cfg_.shear_strength, cfg_.mode_i_energy,
-                            cfg_.mode_ii_energy, cfg_.bk_exponent};
+      const CohesiveLaw law{k / A,
+                            cfg_.normal_strength,
+                            cfg_.shear_strength,
+                            cfg_.mode_i_energy,
+                            cfg_.mode_ii_energy,
+                            cfg_.bk_exponent};
       const double ds = std::sqrt(std::max(d2 - dn * dn, 0.0));
       CohesiveState& st = state_[t];
       const double d_old = st.damage;
@@ -293,7 +303,8 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
       if (alive_[t] == 2 || (st.damage >= 1.0 && dn >= 0)) {
         alive_[t] = 0;
         ++failed;
-        released += 0.5 * (1 - st.damage) * k * (dnp * dnp + ds * ds) + (dn < 0 ? 0.5 * k * dn * dn : 0.0);
+        released +=
+            0.5 * (1 - st.damage) * k * (dnp * dnp + ds * ds) + (dn < 0 ? 0.5 * k * dn * dn : 0.0);
         continue;
       }
       // Force on the slave node: -A (tn n + ts s), s the sliding direction.
@@ -335,7 +346,9 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
 void TiedContact::erode(const std::vector<std::int32_t>& mesh_elements) {
   std::vector<std::int32_t> gone(mesh_elements);
   std::sort(gone.begin(), gone.end());
-  auto is_gone = [&](std::int32_t h) { return h >= 0 && std::binary_search(gone.begin(), gone.end(), h); };
+  auto is_gone = [&](std::int32_t h) {
+    return h >= 0 && std::binary_search(gone.begin(), gone.end(), h);
+  };
   for (std::size_t t = 0; t < node_.size(); ++t)
     if (alive_[t] && (is_gone(seg_hex_[t]) || is_gone(slave_hex_[t]))) alive_[t] = 2;
 }

@@ -54,18 +54,18 @@ class TiedContact final : public ContactAlgorithm {
   bool cohesive_ = false;
   double search_distance_ = 0;
   // One entry per tie (structure of arrays).
-  std::vector<std::int32_t> node_;    // [n_tie] slave node
-  std::vector<std::int32_t> corner_;  // [n_tie][4] master segment corners
-  std::vector<double> xi_, eta_;      // [n_tie] local coordinates on the segment
-  std::vector<double> offset_;        // [n_tie][3] initial offset along (t1, t2, n) of the segment
-  std::vector<double> stiffness_;     // [n_tie] k, N/m
-  std::vector<double> normal_cap_;    // [n_tie] tensile strength * area, N (0: none)
-  std::vector<double> shear_cap_;     // [n_tie] shear strength * area, N (0: none)
+  std::vector<std::int32_t> node_;     // [n_tie] slave node
+  std::vector<std::int32_t> corner_;   // [n_tie][4] master segment corners
+  std::vector<double> xi_, eta_;       // [n_tie] local coordinates on the segment
+  std::vector<double> offset_;         // [n_tie][3] initial offset along (t1, t2, n) of the segment
+  std::vector<double> stiffness_;      // [n_tie] k, N/m
+  std::vector<double> normal_cap_;     // [n_tie] tensile strength * area, N (0: none)
+  std::vector<double> shear_cap_;      // [n_tie] shear strength * area, N (0: none)
   std::vector<std::int32_t> seg_hex_;  // [n_tie] hexahedron owning the master segment
   std::vector<std::int32_t> slave_hex_;  // [n_tie] a hexahedron of the slave face (-1: unknown)
   std::vector<double> area_;             // [n_tie] tributary area, m^2
   std::vector<CohesiveState> state_;     // [n_tie] cohesive state (cohesive ties)
-  std::vector<std::uint8_t> alive_;    // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
+  std::vector<std::uint8_t> alive_;      // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
   std::int64_t n_alive_ = 0;
   double dissipation_ = 0;
   V3 force_;  // on the slave group, N

@@ -3,17 +3,16 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include "fem/elements/hex8_block.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
-
-#include "fem/errors.hpp"
 #include "fem/elements/element_kind.hpp"
 #include "fem/elements/hex8_basis.hpp"
 #include "fem/elements/simd_batch.hpp"
+#include "fem/errors.hpp"
 
 namespace ncfsim::fem {
 namespace stdx = std::experimental;
@@ -94,8 +93,8 @@ inline double max_face_area_sq(const Vec3 x[8]) {
   for (int I = 0; I < 8; ++I) c = c + 0.125 * x[I];
   std::ostringstream os;
   os << "hexahedron " << b.user_id[e] << " (part " << b.part << ") has "
-     << (std::isfinite(V) ? "a non-positive volume " : "a non-finite volume ") << V
-     << " m^3 at (" << c.x << ", " << c.y << ", " << c.z << ") m";
+     << (std::isfinite(V) ? "a non-positive volume " : "a non-finite volume ") << V << " m^3 at ("
+     << c.x << ", " << c.y << ", " << c.z << ") m";
   throw NumericalError(os.str());
 }
 
@@ -238,7 +237,8 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
       double xr[8][3];
       for (int I = 0; I < 8; ++I) xr[I][0] = xe[I].x, xr[I][1] = xe[I].y, xr[I][2] = xe[I].z;
       const auto L = hex8_axis_lengths(xr, M);
-      for (int c = 0; c < 3; ++c) b.axis_length[static_cast<std::size_t>(c) * n + e] = L[static_cast<std::size_t>(c)];
+      for (int c = 0; c < 3; ++c)
+        b.axis_length[static_cast<std::size_t>(c) * n + e] = L[static_cast<std::size_t>(c)];
     }
     double R[9], l[3];
     hex_frame(g, R, l);
@@ -251,7 +251,8 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
     for (int k = 0; k < 9; ++k) b.mat_axes[k * n + e] = M[k];
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c)
-        b.jac_inv0_axes[(3 * r + c) * n + e] = Ji[3 * r] * M[c] + Ji[3 * r + 1] * M[3 + c] + Ji[3 * r + 2] * M[6 + c];
+        b.jac_inv0_axes[(3 * r + c) * n + e] =
+            Ji[3 * r] * M[c] + Ji[3 * r + 1] * M[3 + c] + Ji[3 * r + 2] * M[6 + c];
     b.volume0[e] = g.V;
     if (directional) {
       // Gram matrix of the reference nodal gradients, D = 8/V^2 sum_k d_k d_k^T, in the material
@@ -476,14 +477,14 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
   // Chunk scratch, [component][CH]: what the force pass needs from the kinematics pass.
   alignas(64) double deps[6][CH];
   alignas(64) double sig_old[6][CH];
-  alignas(64) double Rm[9][CH];   // element frame (columns e1 e2 e3)
-  alignas(64) double Qm[9][CH];   // F M: deformation gradient times reference material axes
+  alignas(64) double Rm[9][CH];  // element frame (columns e1 e2 e3)
+  alignas(64) double Qm[9][CH];  // F M: deformation gradient times reference material axes
   alignas(64) double Vol[CH];
   alignas(64) double iVol[CH];
   alignas(64) double Dk[6][3][CH];  // d_1..d_6
   alignas(64) double Ak[4][3][CH];  // a_4..a_7
   alignas(64) double qdot[12][CH];  // hourglass rates, element frame, [3*mode+axis]
-  alignas(64) double ilen[3][CH];  // reciprocal half lengths of the element frame
+  alignas(64) double ilen[3][CH];   // reciprocal half lengths of the element frame
   alignas(64) double dtc[CH];
 
   VD e_int = 0.0, e_stab = 0.0, e_hg = 0.0;
@@ -511,7 +512,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
     auto rows = [&]<int rw>(const auto* base, int n_rows, std::integral_constant<int, rw>) {
       constexpr std::size_t per_line = 64 / sizeof(*base);
       for (int r = 0; r < n_rows; ++r)
-        for (std::size_t k = 0; k < cn; k += per_line) __builtin_prefetch(base + r * n + c0 + k, rw, 2);
+        for (std::size_t k = 0; k < cn; k += per_line)
+          __builtin_prefetch(base + r * n + c0 + k, rw, 2);
     };
     constexpr std::integral_constant<int, 0> read{};
     constexpr std::integral_constant<int, 1> write{};
@@ -541,7 +543,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       for (int I = 0; I < 8; ++I) {
         const std::int32_t* ci = conn + I * n + e;
         std::size_t idx[W];
-        for (int l = 0; l < W; ++l) idx[l] = 3 * static_cast<std::size_t>(ci[l < cnt ? l : cnt - 1]);
+        for (int l = 0; l < W; ++l)
+          idx[l] = 3 * static_cast<std::size_t>(ci[l < cnt ? l : cnt - 1]);
         for (int c = 0; c < 3; ++c) {
           xu[c][I] = VD([&](auto l) { return x[idx[l] + c]; });
           vu[c][I] = VD([&](auto l) { return v[idx[l] + c]; });
@@ -563,8 +566,10 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         constexpr int F[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
                                  {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
         for (const auto& fc : F) {
-          const V3v d1{xu[0][fc[2]] - xu[0][fc[0]], xu[1][fc[2]] - xu[1][fc[0]], xu[2][fc[2]] - xu[2][fc[0]]};
-          const V3v d2{xu[0][fc[3]] - xu[0][fc[1]], xu[1][fc[3]] - xu[1][fc[1]], xu[2][fc[3]] - xu[2][fc[1]]};
+          const V3v d1{xu[0][fc[2]] - xu[0][fc[0]], xu[1][fc[2]] - xu[1][fc[0]],
+                       xu[2][fc[2]] - xu[2][fc[0]]};
+          const V3v d2{xu[0][fc[3]] - xu[0][fc[1]], xu[1][fc[3]] - xu[1][fc[1]],
+                       xu[2][fc[3]] - xu[2][fc[1]]};
           const V3v cr = cross(d1, d2);
           amax_sq = stdx::max(amax_sq, 0.25 * dot(cr, cr));
         }
@@ -647,8 +652,10 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         store_a(&Ak[al][0][j], aa.x), store_a(&Ak[al][1][j], aa.y), store_a(&Ak[al][2][j], aa.z);
       }
       for (int k = 1; k < 7; ++k)
-        store_a(&Dk[k - 1][0][j], d[k].x), store_a(&Dk[k - 1][1][j], d[k].y), store_a(&Dk[k - 1][2][j], d[k].z);
-      store_a(&ilen[0][j], in1), store_a(&ilen[1][j], in2), store_a(&ilen[2][j], 1.0 / stdx::abs(dot(a[3], e3)));
+        store_a(&Dk[k - 1][0][j], d[k].x), store_a(&Dk[k - 1][1][j], d[k].y),
+            store_a(&Dk[k - 1][2][j], d[k].z);
+      store_a(&ilen[0][j], in1), store_a(&ilen[1][j], in2),
+          store_a(&ilen[2][j], 1.0 / stdx::abs(dot(a[3], e3)));
       store_a(&Vol[j], V);
       store_a(&iVol[j], iV);
       // Characteristic length V / A_max over the wave speed sqrt(p_modulus / rho), or the
@@ -707,15 +714,18 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       for (int k = 0; k < 9; ++k) Q[k] = load_a(&Qm[k][j]);
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
-          SQt[3 * r + c] = Sm[3 * r] * Q[3 * c] + Sm[3 * r + 1] * Q[3 * c + 1] + Sm[3 * r + 2] * Q[3 * c + 2];
+          SQt[3 * r + c] =
+              Sm[3 * r] * Q[3 * c] + Sm[3 * r + 1] * Q[3 * c + 1] + Sm[3 * r + 2] * Q[3 * c + 2];
       const VD iJ = V0 * iV;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
-          sg[3 * r + c] = iJ * (Q[3 * r] * SQt[c] + Q[3 * r + 1] * SQt[3 + c] + Q[3 * r + 2] * SQt[6 + c]);
+          sg[3 * r + c] =
+              iJ * (Q[3 * r] * SQt[c] + Q[3 * r + 1] * SQt[3 + c] + Q[3 * r + 2] * SQt[6 + c]);
 
       // Physical stabilisation: incremental generalised forces in the element frame.
       const VD il1 = load_a(&ilen[0][j]), il2 = load_a(&ilen[1][j]), il3 = load_a(&ilen[2][j]);
-      const VD E1 = load(hgm + e, cnt), E2 = load(hgm + n + e, cnt), E3 = load(hgm + 2 * n + e, cnt);
+      const VD E1 = load(hgm + e, cnt), E2 = load(hgm + n + e, cnt),
+               E3 = load(hgm + 2 * n + e, cnt);
       const VD G12 = load(hgm + 3 * n + e, cnt), G23 = load(hgm + 4 * n + e, cnt),
                G13 = load(hgm + 5 * n + e, cnt);
       VD qd[12], dc[12];
@@ -735,7 +745,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       dQ[3 * 3 + 2] = ninth * k3 * dc[3 * 3 + 2];
       {  // twist modes, coupled through the shear strains they share
         const VD c11 = dc[0], c22 = dc[4], c33 = dc[8];
-        const VD s12 = c11 * il2 + c22 * il1, s13 = c11 * il3 + c33 * il1, s23 = c22 * il3 + c33 * il2;
+        const VD s12 = c11 * il2 + c22 * il1, s13 = c11 * il3 + c33 * il1,
+                 s23 = c22 * il3 + c33 * il2;
         dQ[0] = third * kV * (G12 * s12 * il2 + G13 * s13 * il3);
         dQ[4] = third * kV * (G12 * s12 * il1 + G23 * s23 * il3);
         dQ[8] = third * kV * (G13 * s13 * il1 + G23 * s23 * il2);
@@ -782,7 +793,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       for (int k = 0; k < 9; ++k) Mt[k] = sg[k] - iV * H[k];
       VD Wc[3][8];  // [component][k]
       for (int k = 1; k < 7; ++k) {
-        const VD dx = load_a(&Dk[k - 1][0][j]), dy = load_a(&Dk[k - 1][1][j]), dz = load_a(&Dk[k - 1][2][j]);
+        const VD dx = load_a(&Dk[k - 1][0][j]), dy = load_a(&Dk[k - 1][1][j]),
+                 dz = load_a(&Dk[k - 1][2][j]);
         Wc[0][k] = Mt[0] * dx + Mt[1] * dy + Mt[2] * dz;
         Wc[1][k] = Mt[3] * dx + Mt[4] * dy + Mt[5] * dz;
         Wc[2][k] = Mt[6] * dx + Mt[7] * dy + Mt[8] * dz;
@@ -801,7 +813,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       }
       for (int l = 0; l < cnt; ++l)  // element order, as the scalar kernel
         for (int I = 0; I < 8; ++I) {
-          const std::size_t node = static_cast<std::size_t>(conn[I * n + e + static_cast<std::size_t>(l)]);
+          const std::size_t node =
+              static_cast<std::size_t>(conn[I * n + e + static_cast<std::size_t>(l)]);
           f[3 * node] -= fl[I][0][l];
           f[3 * node + 1] -= fl[I][1][l];
           f[3 * node + 2] -= fl[I][2][l];

@@ -25,15 +25,18 @@ namespace ncfsim::fem {
 struct Hex8Block {
   int part = 0;
   const SolidMaterial* material = nullptr;  // borrowed, outlives the block
-  int material_index = -1;                   // index into Model::materials
+  int material_index = -1;                  // index into Model::materials
   std::size_t n = 0;
-  std::vector<std::int32_t> conn;      // [8][n] node indices
-  std::vector<std::int64_t> user_id;   // [n]
-  std::vector<double> stress;          // [6][n] 2nd Piola-Kirchhoff stress, reference material axes
-  std::vector<double> strain;          // [6][n] Green-Lagrange strain, reference material axes (engineering shear)
-  std::vector<double> history;         // [n_history][n]
-  std::vector<double> hg_force;        // [12][n] hourglass generalised forces, element frame, [3*mode+axis]
-  std::vector<double> mat_axes;        // [9][n] reference material axes, global (row-major, axes = columns)
+  std::vector<std::int32_t> conn;     // [8][n] node indices
+  std::vector<std::int64_t> user_id;  // [n]
+  std::vector<double> stress;         // [6][n] 2nd Piola-Kirchhoff stress, reference material axes
+  std::vector<double>
+      strain;  // [6][n] Green-Lagrange strain, reference material axes (engineering shear)
+  std::vector<double> history;  // [n_history][n]
+  std::vector<double>
+      hg_force;  // [12][n] hourglass generalised forces, element frame, [3*mode+axis]
+  std::vector<double>
+      mat_axes;  // [9][n] reference material axes, global (row-major, axes = columns)
   std::vector<double> jac_inv0;        // [9][n] inverse of the reference centre Jacobian
   std::vector<double> jac_inv0_axes;   // [9][n] jac_inv0 * mat_axes: F M = J jac_inv0_axes (kernel)
   std::vector<double> hg_moduli;       // [6][n] E1 E2 E3 G12 G23 G13 along the element axes
@@ -43,9 +46,9 @@ struct Hex8Block {
   std::vector<std::int32_t> mesh_hex;  // [n] index into the mesh's hexahedron set
   std::vector<std::uint8_t> eroded;    // [n] 1: removed from the calculation (empty: none yet)
   std::size_t n_eroded = 0;
-  double hourglass_stiffness = 1.0;    // scale of the physical stabilisation (1 = exact bending)
-  double hourglass_viscosity = 0.05;   // fraction of critical damping on the hourglass modes
-  double p_modulus = 0.0;              // modulus of the stable-step bound (uniform-strain hex)
+  double hourglass_stiffness = 1.0;   // scale of the physical stabilisation (1 = exact bending)
+  double hourglass_viscosity = 0.05;  // fraction of critical damping on the hourglass modes
+  double p_modulus = 0.0;             // modulus of the stable-step bound (uniform-strain hex)
   // Directional step bound: lambda = largest eigenvalue of C G(D0), with D0 = sum_I B0_I B0_I^T
   // of the reference nodal gradients in the material axes, G the 6x6 Gram matrix of the strain
   // operator they make and C the material's stable-step stiffness: the uniform-strain modes of
@@ -68,7 +71,8 @@ struct Hex8Block {
 /// configuration; `element_axes` [9][n] (same layout, per element, block order), when given,
 /// replaces it element by element. Throws NumericalError naming the element if a volume is not
 /// positive.
-void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& material_axes_global,
+void hex8_initialise(Hex8Block& b, const double* x_ref,
+                     const std::array<double, 9>& material_axes_global,
                      const double* element_axes = nullptr);
 
 /// Length of a hexahedron (corners x, VTK order) along each of the axes (row-major, axes as

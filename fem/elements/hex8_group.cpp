@@ -73,9 +73,10 @@ std::unique_ptr<ElementGroup> make_hex8_group(const Model& model, const ElementS
                                               const std::vector<std::size_t>& elements,
                                               const double* x_ref) {
   const PartProperties& pp = model.parts[static_cast<std::size_t>(part)];
-  const int material = !set.material.empty() && !elements.empty() && set.material[elements.front()] >= 0
-                           ? set.material[elements.front()]
-                           : pp.material;
+  const int material =
+      !set.material.empty() && !elements.empty() && set.material[elements.front()] >= 0
+          ? set.material[elements.front()]
+          : pp.material;
   if (material < 0 || static_cast<std::size_t>(material) >= model.materials.size())
     throw InputError("",
                      "part." + model.mesh.part_names[static_cast<std::size_t>(part)] + ".material",
@@ -101,7 +102,8 @@ std::unique_ptr<ElementGroup> make_hex8_group(const Model& model, const ElementS
   if (!set.material_axes.empty()) {
     element_axes.resize(9 * b.n);
     for (std::size_t j = 0; j < b.n; ++j)
-      for (std::size_t k = 0; k < 9; ++k) element_axes[k * b.n + j] = set.material_axes[9 * elements[j] + k];
+      for (std::size_t k = 0; k < 9; ++k)
+        element_axes[k * b.n + j] = set.material_axes[9 * elements[j] + k];
   }
   hex8_initialise(b, x_ref, pp.material_axes, element_axes.empty() ? nullptr : element_axes.data());
   g->bind();

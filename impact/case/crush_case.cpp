@@ -166,29 +166,35 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
       const auto p = static_cast<std::size_t>(rm.hex8[8 * h + I]);
       if (node_of[p] < 0) {
         node_of[p] = static_cast<std::int32_t>(mesh.n_nodes());
-        for (int c = 0; c < 3; ++c) mesh.coords.push_back(rm.points[3 * p + static_cast<std::size_t>(c)]);
+        for (int c = 0; c < 3; ++c)
+          mesh.coords.push_back(rm.points[3 * p + static_cast<std::size_t>(c)]);
         mesh.node_user_id.push_back(rm.node_user_id.empty() ? static_cast<std::int64_t>(p + 1)
                                                             : rm.node_user_id[p]);
       }
       nodes[I] = node_of[p];
     }
     hexes.add(std::span<const std::int32_t>(nodes, 8), rm.hex_part[h]);
-    hexes.user_id.push_back(rm.hex_user_id.empty() ? static_cast<std::int64_t>(h + 1) : rm.hex_user_id[h]);
+    hexes.user_id.push_back(rm.hex_user_id.empty() ? static_cast<std::int64_t>(h + 1)
+                                                   : rm.hex_user_id[h]);
     hexes.ply.push_back(rm.hex_ply.empty() ? -1 : rm.hex_ply[h]);
     hexes.tow.push_back(rm.hex_tow.empty() ? -1 : rm.hex_tow[h]);
     for (int r = 0; r < 3; ++r)
-      for (const auto* f : {&f1, &f2, &f3}) hexes.material_axes.push_back(f->values[3 * h + static_cast<std::size_t>(r)]);
+      for (const auto* f : {&f1, &f2, &f3})
+        hexes.material_axes.push_back(f->values[3 * h + static_cast<std::size_t>(r)]);
     // Vf classes: the class's constants are those of its first element.
     const double c = cls.values[h];
-    if (!(c >= 0) || c != std::floor(c)) m.fail("source", fmt::format("hexahedron {} has no Vf class", hexes.user_id.back()));
+    if (!(c >= 0) || c != std::floor(c))
+      m.fail("source", fmt::format("hexahedron {} has no Vf class", hexes.user_id.back()));
     const auto k = static_cast<std::size_t>(c);
     if (k >= im.classes.size()) im.classes.resize(k + 1);
     ImpregnatedClass& ic = im.classes[k];
     if (ic.n_elements++ == 0) {
-      ic.name = k < rm.material_names.size() ? rm.material_names[k] : fmt::format("tow_class_{}", k);
+      ic.name =
+          k < rm.material_names.size() ? rm.material_names[k] : fmt::format("tow_class_{}", k);
       ic.density = (*rho)[h];
       auto& el = ic.elastic;
-      double* dst[9] = {&el.E1, &el.E2, &el.E3, &el.nu12, &el.nu13, &el.nu23, &el.G12, &el.G13, &el.G23};
+      double* dst[9] = {&el.E1,   &el.E2,  &el.E3,  &el.nu12, &el.nu13,
+                        &el.nu23, &el.G12, &el.G13, &el.G23};
       for (int q = 0; q < 9; ++q) *dst[q] = (*E[q])[h];
       auto& s = ic.strength;
       double* sd[6] = {&s.Xt, &s.Xc, &s.Yt, &s.Yc, &s.S12, &s.S23};
@@ -320,22 +326,28 @@ void check_crack_band(const CaseReadContext& ctx) {
                        ? hexes.material[h]
                        : ctx.model.parts[static_cast<std::size_t>(hexes.part[h])].material;
     if (mi < 0) continue;
-    const auto* mat = dynamic_cast<const TowDamageMaterial*>(ctx.model.materials[static_cast<std::size_t>(mi)].get());
+    const auto* mat = dynamic_cast<const TowDamageMaterial*>(
+        ctx.model.materials[static_cast<std::size_t>(mi)].get());
     if (!mat) continue;
-    std::array<double, 9> axes = ctx.model.parts[static_cast<std::size_t>(hexes.part[h])].material_axes;
+    std::array<double, 9> axes =
+        ctx.model.parts[static_cast<std::size_t>(hexes.part[h])].material_axes;
     if (!hexes.material_axes.empty())
-      std::copy_n(hexes.material_axes.begin() + static_cast<std::ptrdiff_t>(9 * h), 9, axes.begin());
+      std::copy_n(hexes.material_axes.begin() + static_cast<std::ptrdiff_t>(9 * h), 9,
+                  axes.begin());
     double x[8][3];
     const auto nodes = hexes.nodes(h);
     for (std::size_t I = 0; I < 8; ++I)
-      for (std::size_t c = 0; c < 3; ++c) x[I][c] = mesh.coords[3 * static_cast<std::size_t>(nodes[I]) + c];
+      for (std::size_t c = 0; c < 3; ++c)
+        x[I][c] = mesh.coords[3 * static_cast<std::size_t>(nodes[I]) + c];
     const auto L = fem::hex8_axis_lengths(x, axes);
     // The length across each mode's crack, as the law takes it (the larger where it chooses).
-    const double across[kModes] = {L[0], L[0], std::max(L[1], L[2]), std::max(L[1], L[2]), L[1], L[1]};
+    const double across[kModes] = {L[0], L[0], std::max(L[1], L[2]), std::max(L[1], L[2]),
+                                   L[1], L[1]};
     auto& w = worst[mat];
     for (int md = 0; md < kModes; ++md) {
       const double r = across[md] / mat->max_element_length(static_cast<FailureMode>(md));
-      if (r > w[static_cast<std::size_t>(md)].ratio) w[static_cast<std::size_t>(md)] = {r, across[md], hexes.user_id[h]};
+      if (r > w[static_cast<std::size_t>(md)].ratio)
+        w[static_cast<std::size_t>(md)] = {r, across[md], hexes.user_id[h]};
     }
   }
   for (const auto& [mat, w] : worst)
@@ -370,7 +382,8 @@ CrushSpec read_crush(const CaseReadContext& ctx) {
     names += (names.empty() ? "" : ", ") + ctx.model.tools[i].name;
   }
   if (cs.punch < 0) t->fail("punch", "no [[tool]] named '" + punch + "' (tools: " + names + ")");
-  if (ctx.model.tools[static_cast<std::size_t>(cs.punch)].motion.kind != fem::ToolMotion::Kind::Velocity)
+  if (ctx.model.tools[static_cast<std::size_t>(cs.punch)].motion.kind !=
+      fem::ToolMotion::Kind::Velocity)
     t->fail("punch", "the punch '" + punch + "' must move at a prescribed velocity");
   cs.cfc = t->number("cfc_class", 600.0, Range::closed(10, 10000));
   return cs;

@@ -35,10 +35,10 @@ struct ImpregnatedClass {
 /// per-element classes, the classes' constants and the tied face pairs per interface wait for
 /// assign_impregnated_parts.
 struct ImpregnatedImport {
-  std::filesystem::path source;            // the transfer's results.h5
+  std::filesystem::path source;             // the transfer's results.h5
   std::vector<std::int32_t> element_class;  // per hexahedron (mesh order)
   std::vector<ImpregnatedClass> classes;
-  std::vector<std::string> interfaces;     // tie interface names (interply, intraply)
+  std::vector<std::string> interfaces;               // tie interface names (interply, intraply)
   std::vector<std::vector<fem::TiedFacePair>> ties;  // per interface
 };
 
@@ -61,8 +61,8 @@ void check_crack_band(const fem::CaseReadContext& ctx);
 /// [crush]: the punch (a tool of the case) and the CFC class of the filtered force.
 struct CrushSpec {
   bool enabled = false;
-  int punch = -1;     // index into Model::tools
-  double cfc = 600;   // SAE J211 channel frequency class of the filtered punch force
+  int punch = -1;    // index into Model::tools
+  double cfc = 600;  // SAE J211 channel frequency class of the filtered punch force
 };
 CrushSpec read_crush(const fem::CaseReadContext& ctx);
 

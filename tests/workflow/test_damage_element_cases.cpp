@@ -17,23 +17,26 @@ namespace {
 
 struct ModeCase {
   const char* file;
-  const char* component;  // the mode's stress component
-  double strength;        // Pa, signed
-  double fracture_energy; // J/m^2
+  const char* component;   // the mode's stress component
+  double strength;         // Pa, signed
+  double fracture_energy;  // J/m^2
 };
 
 constexpr double kLength = 5e-4, kVolume = kLength * kLength * kLength;
 
 void check_mode(const ModeCase& c) {
   const fs::path out = fresh_dir(std::string("damage_") + c.file);
-  const auto r = run_cli({"-q", "run", (kSource / "cases/verification/damage" / (std::string(c.file) + ".toml")).string(),
-                          "-o", out.string()});
+  const auto r =
+      run_cli({"-q", "run",
+               (kSource / "cases/verification/damage" / (std::string(c.file) + ".toml")).string(),
+               "-o", out.string()});
   ASSERT_EQ(r.code, 0) << r.output;
   const History h = read_history(out / "history.csv");
   const std::size_t s = h.column(std::string("element_stress_") + c.component + "_Pa");
   ASSERT_LT(s, h.columns.size());
   double peak = 0;
-  for (const auto& row : h.rows) peak = c.strength > 0 ? std::max(peak, row[s]) : std::min(peak, row[s]);
+  for (const auto& row : h.rows)
+    peak = c.strength > 0 ? std::max(peak, row[s]) : std::min(peak, row[s]);
   EXPECT_NEAR(peak / c.strength, 1.0, 0.005) << c.file;
   const auto& last = h.rows.back();
   double elastic = 0;

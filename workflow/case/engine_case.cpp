@@ -81,7 +81,8 @@ void read_output(const CaseReadContext& ctx, EngineCase& ec) {
     ec.probes.push_back({t.string("name"), fem::select_nodes(ctx, t, "nodes")});
   const auto& hexes = ctx.model.mesh.elements(fem::ElementKind::Hex8);
   for (const auto& t : o->tables("element")) {
-    ElementProbe ep{t.string("name"), t.integer("element", 1, std::numeric_limits<std::int64_t>::max())};
+    ElementProbe ep{t.string("name"),
+                    t.integer("element", 1, std::numeric_limits<std::int64_t>::max())};
     if (std::find(hexes.user_id.begin(), hexes.user_id.end(), ep.element) == hexes.user_id.end())
       t.fail("element", "no hexahedron has the id " + std::to_string(ep.element));
     ec.element_probes.push_back(ep);
@@ -127,12 +128,27 @@ PictureSpec read_picture(const TableReader& t, const fem::Mesh& mesh) {
   PictureSpec p;
   p.name = t.string("name");
   p.field = t.choice("field",
-                     {"displacement_magnitude", "displacement", "velocity", "stress",
-                      "von_mises_stress", "fibre_direction", "axial_force", "axial_strain",
-                      "shear_angle_deg", "interply_slip_m", "wrinkle_angle_deg", "vf",
-                      "damage_fibre_tension", "damage_fibre_compression", "damage_matrix_tension",
-                      "damage_matrix_compression", "damage_in_plane_shear",
-                      "damage_transverse_shear", "failed_mode", "eroded", "none"},
+                     {"displacement_magnitude",
+                      "displacement",
+                      "velocity",
+                      "stress",
+                      "von_mises_stress",
+                      "fibre_direction",
+                      "axial_force",
+                      "axial_strain",
+                      "shear_angle_deg",
+                      "interply_slip_m",
+                      "wrinkle_angle_deg",
+                      "vf",
+                      "damage_fibre_tension",
+                      "damage_fibre_compression",
+                      "damage_matrix_tension",
+                      "damage_matrix_compression",
+                      "damage_in_plane_shear",
+                      "damage_transverse_shear",
+                      "failed_mode",
+                      "eroded",
+                      "none"},
                      "displacement_magnitude");
   p.component = static_cast<int>(t.integer("component", -1, -1, 5));
   p.camera = t.choice("camera", {"iso", "top", "front"}, "iso");
@@ -180,7 +196,9 @@ EngineCase load_engine_case(const std::filesystem::path& file,
   if (imported && ctx.root.has("mesh"))
     ctx.root.fail("model", "give either [mesh] or [model] (an imported transfer result), not both");
   if (ec.kind == "crush" && !imported)
-    ctx.root.fail("model", "missing: a crush case reads its part from a transfer's results ([model] source = ...)");
+    ctx.root.fail(
+        "model",
+        "missing: a crush case reads its part from a transfer's results ([model] source = ...)");
   impact::ImpregnatedImport import;
   std::vector<drape::FabricEntry> fabrics;
   if (imported)

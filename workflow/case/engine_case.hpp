@@ -1,15 +1,15 @@
 #pragma once
-// A case for the explicit engine, read from TOML: mesh (structured blocks and bar lines), materials,
-// bar laws, parts, constraints, loads, rigid tools, time controls, output, figures.
-// The keys are documented in docs/case-file.md; every value is range-checked before any run, once,
-// by the module that owns its section (fem/case, drape/case; docs/architecture.md).
+// A case for the explicit engine, read from TOML: mesh (structured blocks and bar lines),
+// materials, bar laws, parts, constraints, loads, rigid tools, time controls, output, figures. The
+// keys are documented in docs/case-file.md; every value is range-checked before any run, once, by
+// the module that owns its section (fem/case, drape/case; docs/architecture.md).
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "drape/probe_specs.hpp"
-#include "impact/case/crush_case.hpp"
 #include "fem/model.hpp"
+#include "impact/case/crush_case.hpp"
 
 namespace ncfsim::fem {
 class CaseTypeRegistry;  // fem/case/case_context.hpp
@@ -41,56 +41,55 @@ struct ReactionProbe {
   std::vector<std::int32_t> nodes;
 };
 
-
 /// Values of history columns at given values of another column, into summary.json as
 /// <label>_at_<x in display units><unit> (e.g. force_N_at_10mm). `analytic` adds the bias-extension
 /// shear angle of Eq. 2 (analytic_shear_angle_deg_at_...).
 struct SummarySamples {
-  std::string x;                    // history column, e.g. clamp_displacement_x_m
-  double x_display_scale = 1e3;     // 1e3: the keys name mm
+  std::string x;                 // history column, e.g. clamp_displacement_x_m
+  double x_display_scale = 1e3;  // 1e3: the keys name mm
   std::string x_unit = "mm";
-  std::vector<double> at;           // in display units
+  std::vector<double> at;                                    // in display units
   std::vector<std::pair<std::string, std::string>> columns;  // label -> history column
   bool bias_extension_analytic = false;
   double coupon_length = 0, coupon_width = 0;  // m (free length H, width W)
 };
-
 
 /// Mean of a history column over a time window, times a scale, into summary.json as <name>
 /// (e.g. the friction coefficient F/P of a sled over its steady sliding).
 struct SummaryMean {
   std::string name, column;
   double from_time = 0, to_time = 0, scale = 1;
-  std::string per_column;  // if set: scale * increment of column / increment of per_column over the window
+  std::string
+      per_column;  // if set: scale * increment of column / increment of per_column over the window
 };
 
 struct OutputSettings {
-  bool xdmf = true;           // results.h5 + results.xdmf
-  bool vtu = false;           // frames/*.vtu + results.pvd
-  bool figures = true;        // render figures at the end of the run
-  bool report = false;        // write report.html at the end of the run
+  bool xdmf = true;     // results.h5 + results.xdmf
+  bool vtu = false;     // frames/*.vtu + results.pvd
+  bool figures = true;  // render figures at the end of the run
+  bool report = false;  // write report.html at the end of the run
 };
 
 /// A curve plot from history.csv: y columns against an x column.
 /// A curve from another CSV (test data, a macro shell result), drawn dashed beside the run's.
 struct ImportedSeries {
   std::string label;
-  std::filesystem::path file;       // absolute, resolved against the case file's folder
-  std::string x, y;                 // column names
+  std::filesystem::path file;  // absolute, resolved against the case file's folder
+  std::string x, y;            // column names
   double x_scale = 1.0, y_scale = 1.0;
 };
 
 /// A horizontal reference line (an analytic value), drawn dashed.
 struct ReferenceLine {
   std::string label;
-  double y = 0;                     // in plotted units (after y_scale)
+  double y = 0;  // in plotted units (after y_scale)
 };
 
 struct PlotSpec {
-  std::string name;                 // file figures/<name>.png
+  std::string name;  // file figures/<name>.png
   std::string title;
-  std::string x;                    // column name
-  std::vector<std::string> y;       // column names
+  std::string x;               // column name
+  std::vector<std::string> y;  // column names
   double x_scale = 1.0, y_scale = 1.0;
   std::string x_label, y_label;
   std::vector<ImportedSeries> imports;
@@ -101,21 +100,20 @@ struct PlotSpec {
 /// A picture of the last frame coloured by a field.
 struct PictureSpec {
   std::string name;
-  std::string field;        // a frame field (docs/output.md) or displacement_magnitude; "none"
-  int component = -1;       // -1: magnitude of a vector/tensor field
-  std::string camera;       // iso | top | front
+  std::string field;   // a frame field (docs/output.md) or displacement_magnitude; "none"
+  int component = -1;  // -1: magnitude of a vector/tensor field
+  std::string camera;  // iso | top | front
   std::string title;
   std::string follow_part;  // the camera fits this part's current bounds ("" = whole model)
   double deformation_scale = 1.0;
 };
 
-
 struct EngineCase {
   std::filesystem::path file;
   std::string name;
-  std::string kind;          // "engine"
+  std::string kind;  // "engine"
   std::string description;
-  std::string resolution;    // coarse | default | fine
+  std::string resolution;  // coarse | default | fine
   fem::Model model;
   std::vector<DisplacementProbe> probes;
   std::vector<ReactionProbe> reactions;
@@ -130,7 +128,7 @@ struct EngineCase {
   std::vector<BendingLengthProbe> bending;
   std::vector<SummaryMean> means;
   std::vector<double> frame_fabric_length;  // per picture frame: side of the fabric for normalising
-  impact::CrushSpec crush;                    // [crush]: the punch's measures (kind crush)
+  impact::CrushSpec crush;                  // [crush]: the punch's measures (kind crush)
 };
 
 /// The material types an engine case knows: fem's, then drape's (tow_biphase), then impact's
@@ -138,6 +136,7 @@ struct EngineCase {
 fem::CaseTypeRegistry engine_case_types();
 
 /// Reads and checks a case (throws InputError naming file and key). `overrides` are --set items.
-EngineCase load_engine_case(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+EngineCase load_engine_case(const std::filesystem::path& file,
+                            const std::vector<std::string>& overrides);
 
 }  // namespace ncfsim::workflow

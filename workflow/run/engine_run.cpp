@@ -35,7 +35,9 @@ std::string hms(double seconds) {
   return fmt::format("{:02}:{:02}", s / 60, s % 60);
 }
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 void clean_previous_results(const std::filesystem::path& dir) {
   for (const char* f : {"results.h5", "results.xdmf", "results.pvd", "history.csv", "summary.json",
@@ -48,7 +50,8 @@ void clean_previous_results(const std::filesystem::path& dir) {
 // results.h5/.xdmf and .vtu frames; a frame that cannot be written is logged, the run goes on.
 class FrameOutput {
  public:
-  FrameOutput(const std::filesystem::path& dir, const OutputSettings& o, const fem::ExplicitSolver& s) {
+  FrameOutput(const std::filesystem::path& dir, const OutputSettings& o,
+              const fem::ExplicitSolver& s) {
     if (!o.xdmf && !o.vtu) return;
     const fem::io::ResultMesh mesh = result_mesh(s);
     if (o.xdmf) xdmf_ = std::make_unique<fem::io::XdmfResultWriter>(dir, mesh);
@@ -59,7 +62,8 @@ class FrameOutput {
     fem::io::Frame fr = make_frame(s);
     std::vector<fem::MeasureCellField> extra;
     for (const auto& m : measures) m->add_frame_fields(s, extra);
-    for (auto& f : extra) fr.fields.push_back({std::move(f.name), true, f.n_components, std::move(f.values)});
+    for (auto& f : extra)
+      fr.fields.push_back({std::move(f.name), true, f.n_components, std::move(f.values)});
     try {
       if (xdmf_) xdmf_->write_frame(fr);
       if (vtu_) vtu_->write_frame(fr);
@@ -85,7 +89,11 @@ class FrameOutput {
 // What the loop and the summary share while a case runs.
 struct Run {
   Run(const EngineCase& c, const RunOptions& o)
-      : ec(c), options(o), dir(output_folder(c, o)), wall0(Clock::now()), summary(summary_header(c, o)) {}
+      : ec(c),
+        options(o),
+        dir(output_folder(c, o)),
+        wall0(Clock::now()),
+        summary(summary_header(c, o)) {}
   const EngineCase& ec;
   const RunOptions& options;
   std::filesystem::path dir;
@@ -94,20 +102,25 @@ struct Run {
   json summary;
   std::string status = "completed", failure;
   double max_error = 0;  // energy balance error over the run after its first 5 %
-  double ke_ie_max = 0;  // kinetic / internal energy at the history rows from time.quasi_static_from
+  double ke_ie_max =
+      0;  // kinetic / internal energy at the history rows from time.quasi_static_from
   bool ke_ie_exceeded = false;
 
-  void write_summary() const { write_file_atomically(dir / "summary.json", summary.dump(2) + "\n"); }
+  void write_summary() const {
+    write_file_atomically(dir / "summary.json", summary.dump(2) + "\n");
+  }
 };
 
 void log_start(const Run& r) {
-  r.log->info("ncfsim {} | case '{}' ({}) | resolution {}", kVersion, r.ec.name, r.ec.file.string(), r.ec.resolution);
+  r.log->info("ncfsim {} | case '{}' ({}) | resolution {}", kVersion, r.ec.name, r.ec.file.string(),
+              r.ec.resolution);
   if (!r.ec.description.empty()) r.log->info("  {}", r.ec.description);
   for (const auto& ov : r.options.overrides) r.log->info("  --set {}", ov);
   if (r.options.ranks > 1)
-    r.log->warn("--np {}: this build runs the engine on one rank; the state is laid out for MPI "
-                "(ghosted PETSc vectors) but the domain decomposition is not implemented yet",
-                r.options.ranks);
+    r.log->warn(
+        "--np {}: this build runs the engine on one rank; the state is laid out for MPI "
+        "(ghosted PETSc vectors) but the domain decomposition is not implemented yet",
+        r.options.ranks);
 }
 
 std::unique_ptr<fem::ExplicitSolver> make_solver(EngineCase& ec, Run& r) {
@@ -121,8 +134,8 @@ std::unique_ptr<fem::ExplicitSolver> make_solver(EngineCase& ec, Run& r) {
   }
 }
 
-void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measures, const RunHistory& history,
-                  const FrameOutput& frames) {
+void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measures,
+                  const RunHistory& history, const FrameOutput& frames) {
   r.summary["status"] = r.status;
   r.summary["wall_seconds"] = seconds_since(r.wall0);
   r.summary["frames"] = frames.written();
@@ -139,7 +152,8 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
 }
 
 // Logs the erosions since the last call; the measures then say what went with them.
-void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size_t& logged, spdlog::logger& log) {
+void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size_t& logged,
+                  spdlog::logger& log) {
   const auto& tc = s.model().time;
   const std::size_t before = logged;
   for (; logged < s.erosions().size(); ++logged) {
@@ -147,18 +161,24 @@ void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size
     const auto& part = s.model().mesh.part_names[static_cast<std::size_t>(ev.part)];
     if (ev.cause == fem::ErosionEvent::Cause::MaterialFailure) {
       // Part of a damage law's progress (thousands in a crush): the log file has them.
-      log.debug("hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, {:.6g}) m: its "
-                "material failed",
-                ev.element, part, ev.time, ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z);
+      log.debug(
+          "hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, {:.6g}) "
+          "m: its "
+          "material failed",
+          ev.element, part, ev.time, ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z);
       continue;
     }
-    const std::string why = ev.cause == fem::ErosionEvent::Cause::InvertedCorner
-                                ? "a corner folded over (corner Jacobian <= 0)"
-                                : fmt::format("its step {:.3g} s fell below time.erosion_step_ratio = {:g} of the "
-                                              "initial one",
-                                              ev.step, tc.erosion_step_ratio);
-    log.warn("hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, {:.6g}) m: {}", ev.element,
-             part, ev.time, ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z, why);
+    const std::string why =
+        ev.cause == fem::ErosionEvent::Cause::InvertedCorner
+            ? "a corner folded over (corner Jacobian <= 0)"
+            : fmt::format(
+                  "its step {:.3g} s fell below time.erosion_step_ratio = {:g} of the "
+                  "initial one",
+                  ev.step, tc.erosion_step_ratio);
+    log.warn(
+        "hexahedron {} (part {}) eroded at t = {:.6g} s, cycle {}, at ({:.6g}, {:.6g}, {:.6g}) m: "
+        "{}",
+        ev.element, part, ev.time, ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z, why);
   }
   if (logged > before)
     for (auto& m : measures)
@@ -168,13 +188,16 @@ void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size
 void log_progress(const Run& r, const fem::ExplicitSolver& s, double err) {
   const auto& tc = s.model().time;
   const double t = s.time(), wall = seconds_since(r.wall0), frac = t / tc.end_time;
-  r.log->info("t = {:.4e} / {:.4e} s ({:4.1f} %) | cycle {} | dt {:.3e} s | wall {} | ETA {} | energy balance {:.3f} %",
-              t, tc.end_time, 100 * frac, s.cycle(), s.time_step(), hms(wall),
-              frac > 0 ? hms(wall * (1 - frac) / frac) : "--:--", 100 * err);
+  r.log->info(
+      "t = {:.4e} / {:.4e} s ({:4.1f} %) | cycle {} | dt {:.3e} s | wall {} | ETA {} | energy "
+      "balance {:.3f} %",
+      t, tc.end_time, 100 * frac, s.cycle(), s.time_step(), hms(wall),
+      frac > 0 ? hms(wall * (1 - frac) / frac) : "--:--", 100 * err);
 }
 
 // The time loop to the end time (or the cycle limit, or an interrupt); returns the exit code.
-int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHistory& history, FrameOutput& frames) {
+int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHistory& history,
+              FrameOutput& frames) {
   const auto& tc = solver.model().time;
   double next_history = 0, next_frame = 0;
   auto last_progress = Clock::now();
@@ -189,15 +212,17 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
       }
       if (StopRequest::requested()) {
         r.status = "interrupted";
-        r.log->warn("interrupted at t = {:.6g} s, cycle {}: writing the last frame and summary", solver.time(),
-                    solver.cycle());
+        r.log->warn("interrupted at t = {:.6g} s, cycle {}: writing the last frame and summary",
+                    solver.time(), solver.cycle());
         break;
       }
       solver.step([&] {
         const double t = solver.time();
         log_erosions(solver, measures, erosions_logged, *r.log);
         const double err = solver.energy().error();
-        if (t > 0.05 * tc.end_time) r.max_error = std::max(r.max_error, err);  // skip the start, when little energy is in play
+        if (t > 0.05 * tc.end_time)
+          r.max_error =
+              std::max(r.max_error, err);  // skip the start, when little energy is in play
         if (t >= next_history) {
           history.write_row(solver);
           next_history += tc.history_interval;
@@ -205,15 +230,19 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
           if (t >= tc.quasi_static_from && en.internal > 0) {
             const double ratio = en.kinetic / en.internal;
             r.ke_ie_max = std::max(r.ke_ie_max, ratio);
-            if (tc.kinetic_to_internal_limit > 0 && ratio > tc.kinetic_to_internal_limit && !r.ke_ie_exceeded) {
-              r.log->warn("kinetic / internal energy {:.3g} passed time.kinetic_to_internal_limit {:.3g} at t = {:.6g} s: "
-                          "not quasi-static (slower tool, less mass scaling)", ratio, tc.kinetic_to_internal_limit, t);
+            if (tc.kinetic_to_internal_limit > 0 && ratio > tc.kinetic_to_internal_limit &&
+                !r.ke_ie_exceeded) {
+              r.log->warn(
+                  "kinetic / internal energy {:.3g} passed time.kinetic_to_internal_limit {:.3g} "
+                  "at t = {:.6g} s: "
+                  "not quasi-static (slower tool, less mass scaling)",
+                  ratio, tc.kinetic_to_internal_limit, t);
               r.ke_ie_exceeded = true;
             }
           }
           if (!exceeded_reported && err > tc.energy_balance_limit && t > 0.05 * tc.end_time) {
-            r.log->warn("energy balance error {:.3g} % passed its limit {:.3g} % at t = {:.6g} s", 100 * err,
-                        100 * tc.energy_balance_limit, t);
+            r.log->warn("energy balance error {:.3g} % passed its limit {:.3g} % at t = {:.6g} s",
+                        100 * err, 100 * tc.energy_balance_limit, t);
             exceeded_reported = true;
           }
         }
@@ -224,7 +253,8 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
           r.write_summary();
           next_frame += tc.frame_interval;
         }
-        if (std::chrono::duration<double>(Clock::now() - last_progress).count() >= r.options.progress_interval_s) {
+        if (std::chrono::duration<double>(Clock::now() - last_progress).count() >=
+            r.options.progress_interval_s) {
           last_progress = Clock::now();
           log_progress(r, solver, err);
         }
@@ -245,18 +275,22 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
 void log_end(const Run& r, const fem::ExplicitSolver& solver) {
   const auto& en = solver.energy();
   const auto& tc = solver.model().time;
-  r.log->info("energy balance at t = {:.6g} s: kinetic {:.5g} J, internal {:.5g} J (stabilisation {:.5g} J), "
-              "hourglass {:.5g} J, contact {:.5g} J (friction {:.5g} J), damping {:.5g} J, external work "
-              "{:.5g} J, error {:.3g} % (limit {:.3g} %)",
-              en.time, en.kinetic, en.internal, en.stabilisation, en.hourglass, en.contact, en.friction, en.damping,
-              en.external_work, 100 * en.error(), 100 * tc.energy_balance_limit);
+  r.log->info(
+      "energy balance at t = {:.6g} s: kinetic {:.5g} J, internal {:.5g} J (stabilisation {:.5g} "
+      "J), "
+      "hourglass {:.5g} J, contact {:.5g} J (friction {:.5g} J), damping {:.5g} J, external work "
+      "{:.5g} J, error {:.3g} % (limit {:.3g} %)",
+      en.time, en.kinetic, en.internal, en.stabilisation, en.hourglass, en.contact, en.friction,
+      en.damping, en.external_work, 100 * en.error(), 100 * tc.energy_balance_limit);
   const auto& tm = solver.timers();
   const double elem_cycles =
       static_cast<double>(solver.cycle()) * static_cast<double>(solver.n_elements());
-  r.log->info("{} cycles in {} | internal force {:.3g} s ({:.0f} ns per element-cycle), contact {:.3g} s, "
-              "update {:.3g} s, output {:.3g} s",
-              solver.cycle(), hms(r.summary["wall_seconds"].get<double>()), tm.internal_force,
-              elem_cycles > 0 ? 1e9 * tm.internal_force / elem_cycles : 0.0, tm.contact, tm.update, tm.output);
+  r.log->info(
+      "{} cycles in {} | internal force {:.3g} s ({:.0f} ns per element-cycle), contact {:.3g} s, "
+      "update {:.3g} s, output {:.3g} s",
+      solver.cycle(), hms(r.summary["wall_seconds"].get<double>()), tm.internal_force,
+      elem_cycles > 0 ? 1e9 * tm.internal_force / elem_cycles : 0.0, tm.contact, tm.update,
+      tm.output);
 }
 
 void draw_figures_and_report(const Run& r) {
@@ -289,7 +323,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   std::filesystem::create_directories(r.dir);
   clean_previous_results(r.dir);
   r.log = make_run_logger(r.dir, options.verbosity);
-  std::filesystem::copy_file(ec.file, r.dir / "case.toml", std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::copy_file(ec.file, r.dir / "case.toml",
+                             std::filesystem::copy_options::overwrite_existing);
   write_figure_specs(r.dir, ec);
   log_start(r);
 
@@ -313,8 +348,9 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   const double err = solver.energy().error();
   if (exit_code == kSuccess && err > tc.energy_balance_limit) {
     r.status = "energy_balance_exceeded";
-    r.failure = fmt::format("energy balance error {:.3g} % is past its limit {:.3g} % (time.energy_balance_limit)",
-                            100 * err, 100 * tc.energy_balance_limit);
+    r.failure = fmt::format(
+        "energy balance error {:.3g} % is past its limit {:.3g} % (time.energy_balance_limit)",
+        100 * err, 100 * tc.energy_balance_limit);
     r.log->error("{}", r.failure);
     exit_code = kNumericalFailure;
   }
@@ -322,7 +358,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   fill_summary(r, solver, measures, history, frames);
   r.write_summary();
   for (const auto& m : measures)
-    for (const auto& f : m->write_files(solver, r.dir)) r.log->info("wrote {}", (r.dir / f).string());
+    for (const auto& f : m->write_files(solver, r.dir))
+      r.log->info("wrote {}", (r.dir / f).string());
   log_end(r, solver);
   draw_figures_and_report(r);
   r.log->info("results in {} (status: {})", r.dir.string(), r.status);

@@ -53,7 +53,8 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
   fr.displacement.resize(3 * nn);
   for (std::size_t d = 0; d < 3 * nn; ++d) fr.displacement[d] = X[d] - X0[d];
   fr.fields.push_back({"velocity", false, 3, std::vector<double>(Vv.data(), Vv.data() + 3 * nn)});
-  const std::size_t nh = s.n_elements(fem::ElementKind::Hex8), nb = s.n_elements(fem::ElementKind::Bar2);
+  const std::size_t nh = s.n_elements(fem::ElementKind::Hex8),
+                    nb = s.n_elements(fem::ElementKind::Bar2);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   fem::io::FrameField stress{"stress", true, 6, std::vector<double>(6 * (nh + nb), nan)};
   fem::io::FrameField vm{"von_mises_stress", true, 1, std::vector<double>(nh + nb, nan)};
@@ -117,7 +118,9 @@ fem::Mesh mesh_from_stage_frame(const fem::io::StageFrame& frame, bool deformed)
   if (nb) {
     fem::ElementSet& bars = m.elements(fem::ElementKind::Bar2);
     for (std::size_t e = 0; e < nb; ++e)
-      bars.add({static_cast<std::int32_t>(rm.bar2[2 * e]), static_cast<std::int32_t>(rm.bar2[2 * e + 1])}, rm.bar_part[e]);
+      bars.add({static_cast<std::int32_t>(rm.bar2[2 * e]),
+                static_cast<std::int32_t>(rm.bar2[2 * e + 1])},
+               rm.bar_part[e]);
     bars.user_id = rm.bar_user_id;
   }
   m.fill_default_user_ids();  // whatever the file did not hold

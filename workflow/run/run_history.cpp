@@ -49,7 +49,8 @@ void RunHistory::write_row(const fem::ExplicitSolver& s) {
   std::vector<double> row;
   row.reserve(columns_.size());
   for (const auto& m : measures_) m->add_values(s, row);
-  row.resize(columns_.size(), std::numeric_limits<double>::quiet_NaN());  // a resultant that came later
+  row.resize(columns_.size(),
+             std::numeric_limits<double>::quiet_NaN());  // a resultant that came later
   writer_->write_row(row);
   if (keep_rows_) rows_.push_back(std::move(row));
 }

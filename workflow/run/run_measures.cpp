@@ -17,16 +17,20 @@ namespace ncfsim::workflow {
 using fem::V3;
 
 fem::V3 tool_axis(const fem::RigidTool& t) {
-  if (t.motion.kind == fem::ToolMotion::Kind::Velocity && norm(t.motion.velocity) > 0) return normalized(t.motion.velocity);
+  if (t.motion.kind == fem::ToolMotion::Kind::Velocity && norm(t.motion.velocity) > 0)
+    return normalized(t.motion.velocity);
   if (t.motion.kind == fem::ToolMotion::Kind::Force) return t.motion.axis;
   return t.surface.axis;
 }
 
-std::string sample_suffix(double at, const std::string& unit) { return fmt::format("_at_{:g}{}", at, unit); }
+std::string sample_suffix(double at, const std::string& unit) {
+  return fmt::format("_at_{:g}{}", at, unit);
+}
 
 namespace {
 
-void add_xyz(std::vector<std::string>& columns, const std::string& prefix, const std::string& unit) {
+void add_xyz(std::vector<std::string>& columns, const std::string& prefix,
+             const std::string& unit) {
   for (const char* c : {"x", "y", "z"}) columns.push_back(prefix + "_" + c + "_" + unit);
 }
 
@@ -35,9 +39,10 @@ class EnergyColumns final : public fem::RunMeasure {
  public:
   explicit EnergyColumns(bool erosion) : erosion_(erosion) {}
   void add_columns(std::vector<std::string>& c) override {
-    for (const char* n : {"time", "cycle", "time_step_s", "kinetic_energy_J", "internal_energy_J",
-                          "stabilisation_energy_J", "hourglass_energy_J", "contact_energy_J", "friction_energy_J",
-                          "damping_energy_J", "external_work_J", "total_energy_J", "energy_balance_error"})
+    for (const char* n :
+         {"time", "cycle", "time_step_s", "kinetic_energy_J", "internal_energy_J",
+          "stabilisation_energy_J", "hourglass_energy_J", "contact_energy_J", "friction_energy_J",
+          "damping_energy_J", "external_work_J", "total_energy_J", "energy_balance_error"})
       c.push_back(n);
     if (erosion_) {
       c.push_back("eroded_elements");
@@ -46,9 +51,9 @@ class EnergyColumns final : public fem::RunMeasure {
   }
   void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override {
     const auto& en = s.energy();
-    for (double v : {s.time(), static_cast<double>(s.cycle()), s.time_step(), en.kinetic, en.internal,
-                     en.stabilisation, en.hourglass, en.contact, en.friction, en.damping, en.external_work,
-                     en.total(), en.error()})
+    for (double v : {s.time(), static_cast<double>(s.cycle()), s.time_step(), en.kinetic,
+                     en.internal, en.stabilisation, en.hourglass, en.contact, en.friction,
+                     en.damping, en.external_work, en.total(), en.error()})
       row.push_back(v);
     if (erosion_) {
       row.push_back(static_cast<double>(s.erosions().size()));
@@ -105,7 +110,9 @@ class ReactionMeasure final : public fem::RunMeasure {
 class DisplacementMeasure final : public fem::RunMeasure {
  public:
   explicit DisplacementMeasure(const DisplacementProbe& p) : p_(p) {}
-  void add_columns(std::vector<std::string>& c) override { add_xyz(c, p_.name + "_displacement", "m"); }
+  void add_columns(std::vector<std::string>& c) override {
+    add_xyz(c, p_.name + "_displacement", "m");
+  }
   void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override {
     for (double v : fem::mean_displacement(s, p_.nodes).arr()) row.push_back(v);
   }
@@ -127,12 +134,18 @@ class ElementMeasure final : public fem::RunMeasure {
         if (b.user_id[e] == p.element) block_ = &b, index_ = e;
   }
   void add_columns(std::vector<std::string>& c) override {
-    for (const char* ij : {"11", "22", "33", "12", "23", "13"}) c.push_back(p_.name + "_stress_" + ij + "_Pa");
-    for (const char* ij : {"11", "22", "33", "12", "23", "13"}) c.push_back(p_.name + "_strain_" + ij);
+    for (const char* ij : {"11", "22", "33", "12", "23", "13"})
+      c.push_back(p_.name + "_stress_" + ij + "_Pa");
+    for (const char* ij : {"11", "22", "33", "12", "23", "13"})
+      c.push_back(p_.name + "_strain_" + ij);
   }
   void add_values(const fem::ExplicitSolver&, std::vector<double>& row) const override {
-    for (int c = 0; c < 6; ++c) row.push_back(block_ ? block_->stress[static_cast<std::size_t>(c) * block_->n + index_] : 0.0);
-    for (int c = 0; c < 6; ++c) row.push_back(block_ ? block_->strain[static_cast<std::size_t>(c) * block_->n + index_] : 0.0);
+    for (int c = 0; c < 6; ++c)
+      row.push_back(block_ ? block_->stress[static_cast<std::size_t>(c) * block_->n + index_]
+                           : 0.0);
+    for (int c = 0; c < 6; ++c)
+      row.push_back(block_ ? block_->strain[static_cast<std::size_t>(c) * block_->n + index_]
+                           : 0.0);
   }
 
  private:
@@ -171,12 +184,14 @@ std::unique_ptr<fem::RunMeasure> make_bias_extension_curve(const EngineCase& ec)
     analytic = &ss;
     drape::BiasExtensionCoupon coupon;
     coupon.length = ss.coupon_length, coupon.width = ss.coupon_width;
-    for (double at : ss.at) points.push_back({sample_suffix(at, ss.x_unit), at / ss.x_display_scale, coupon});
+    for (double at : ss.at)
+      points.push_back({sample_suffix(at, ss.x_unit), at / ss.x_display_scale, coupon});
   }
   if (!analytic) return nullptr;
   drape::BiasExtensionCoupon coupon;
   coupon.length = analytic->coupon_length, coupon.width = analytic->coupon_width;
-  return std::make_unique<drape::BiasExtensionCurve>(analytic->x, coupon, std::move(points), ec.file.string());
+  return std::make_unique<drape::BiasExtensionCurve>(analytic->x, coupon, std::move(points),
+                                                     ec.file.string());
 }
 
 }  // namespace
@@ -188,16 +203,22 @@ MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s
   for (const auto& t : model.tools) m.push_back(std::make_unique<ToolMeasure>(t));
   for (const auto& r : ec.reactions) m.push_back(std::make_unique<ReactionMeasure>(r));
   for (std::size_t k = 0; k < model.picture_frames.size(); ++k)
-    m.push_back(std::make_unique<drape::PictureFrameForce>(k, model.picture_frames[k], ec.frame_fabric_length[k]));
+    m.push_back(std::make_unique<drape::PictureFrameForce>(k, model.picture_frames[k],
+                                                           ec.frame_fabric_length[k]));
   for (const auto& p : ec.probes) m.push_back(std::make_unique<DisplacementMeasure>(p));
   for (const auto& p : ec.element_probes) m.push_back(std::make_unique<ElementMeasure>(p, s));
-  for (const auto& sp : ec.shear_probes) m.push_back(std::make_unique<drape::ShearAngleProbe>(sp, s, ec.file.string()));
-  for (const auto& bp : ec.bending) m.push_back(std::make_unique<drape::BendingLengthMeasure>(bp, s));
-  for (const auto& rp : ec.ring_probes) m.push_back(std::make_unique<drape::RingShearMeasure>(rp, s));
+  for (const auto& sp : ec.shear_probes)
+    m.push_back(std::make_unique<drape::ShearAngleProbe>(sp, s, ec.file.string()));
+  for (const auto& bp : ec.bending)
+    m.push_back(std::make_unique<drape::BendingLengthMeasure>(bp, s));
+  for (const auto& rp : ec.ring_probes)
+    m.push_back(std::make_unique<drape::RingShearMeasure>(rp, s));
   if (auto curve = make_bias_extension_curve(ec)) m.push_back(std::move(curve));
-  if (ec.crush.enabled) m.push_back(std::make_unique<impact::CrushMeasure>(s, ec.crush.punch, ec.crush.cfc));
+  if (ec.crush.enabled)
+    m.push_back(std::make_unique<impact::CrushMeasure>(s, ec.crush.punch, ec.crush.cfc));
   m.push_back(std::make_unique<ContactResultants>());
-  if (!ec.fabric_summaries.empty()) m.push_back(std::make_unique<drape::FabricReport>(ec.fabric_summaries, model));
+  if (!ec.fabric_summaries.empty())
+    m.push_back(std::make_unique<drape::FabricReport>(ec.fabric_summaries, model));
   // After the report, which writes each fabric's summary entry anew.
   for (const auto& f : ec.fabric_summaries)
     if (f.ply_parts.size() == 2)

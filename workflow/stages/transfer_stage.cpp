@@ -243,9 +243,10 @@ int run_transfer_stage(const StageCall& call) {
       tc.spec.mapping.vf_undeformed, m.classes.size());
   for (const auto& t : m.ties) log->info("tied {}: {} face pairs", t.name, t.slave.size());
   if (m.n_lost)
-    log->warn("{} tow hexahedra not mapped: {} eroded in the drape, {} with a non-positive volume or "
-              "the fibre along the thickness",
-              m.n_lost, m.n_eroded, m.n_lost - m.n_eroded);
+    log->warn(
+        "{} tow hexahedra not mapped: {} eroded in the drape, {} with a non-positive volume or "
+        "the fibre along the thickness",
+        m.n_lost, m.n_eroded, m.n_lost - m.n_eroded);
 
   if (tc.frames_xdmf) write_results(dir, m);
   write_file_atomically(dir / "materials.csv", materials_csv(m));
