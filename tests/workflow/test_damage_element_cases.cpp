@@ -69,5 +69,25 @@ TEST(CliVerificationDamage, TransverseShearPeaksAtS23AndDissipatesGOverL) {
   check_mode({"transverse_shear", "23", 60e6, 500});
 }
 
+// A fracture energy too small for the element (snap-back: the crack band needs L < 2 G E / X^2)
+// is bad input naming the key and the limit; so are a zero strength and a negative energy.
+TEST(CliVerificationDamage, RefusesSnapBackAndNonPositiveData) {
+  const std::string c = (kSource / "cases/verification/damage/fibre_tension.toml").string();
+  // 2 G E / X^2 with G = 1 kJ/m^2: 0.053 mm < 0.5 mm.
+  auto r = run_cli({"check", c, "--set", "material[0].fracture_energy.fibre_tension=1000.0"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("material[0].fracture_energy.fibre_tension"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("snap-back"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("give at least"), std::string::npos) << r.output;
+  r = run_cli({"check", c, "--set", "material[0].Xt=0.0"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("material[0].Xt"), std::string::npos) << r.output;
+  r = run_cli({"check", c, "--set", "material[0].fracture_energy.matrix_tension=-5.0"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("material[0].fracture_energy.matrix_tension"), std::string::npos)
+      << r.output;
+}
+
 }  // namespace
 }  // namespace ncfsim::test
