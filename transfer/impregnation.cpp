@@ -23,6 +23,21 @@ void MappingSpec::validate() const {
     throw std::invalid_argument("vf_bin: must be in (0, 0.1] (got " + std::to_string(vf_bin) + ")");
 }
 
+double min_scaled_corner_jacobian(const std::array<V3, 8>& x) {
+  // The three edges leaving each corner, right-handed (bottom face 0-3, top 4-7 above them).
+  static constexpr int kEdges[8][3] = {{1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7},
+                                       {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}};
+  double q = 1.0;
+  for (std::size_t c = 0; c < 8; ++c) {
+    const V3 a = x[static_cast<std::size_t>(kEdges[c][0])] - x[c],
+             b = x[static_cast<std::size_t>(kEdges[c][1])] - x[c],
+             d = x[static_cast<std::size_t>(kEdges[c][2])] - x[c];
+    const double l = norm(a) * norm(b) * norm(d);
+    q = std::min(q, l > 0 ? dot(cross(a, b), d) / l : -1.0);
+  }
+  return q;
+}
+
 double hex_volume(const std::array<V3, 8>& x) {
   // Natural coordinates of the VTK corners.
   static constexpr double kXi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},

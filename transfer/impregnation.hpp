@@ -48,6 +48,11 @@ struct ImpregnatedMapping {
 /// Exact volume of a trilinear hexahedron (2 x 2 x 2 Gauss points integrate its Jacobian exactly).
 double hex_volume(const std::array<fem::V3, 8>& x);
 
+/// Smallest scaled corner Jacobian of a hexahedron (VTK order): at each corner the triple product
+/// of the three edges leaving it over the product of their lengths; 1 for a box, <= 0 where the
+/// element folds over at a corner (which its volume does not show).
+double min_scaled_corner_jacobian(const std::array<fem::V3, 8>& x);
+
 /// Throws std::invalid_argument for a bad spec and std::runtime_error naming the element for a
 /// hexahedron with a non-positive volume or a fibre direction along its thickness.
 ImpregnatedMapping map_impregnated(const DrapedTows& tows, const MappingSpec& spec);

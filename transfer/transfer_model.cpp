@@ -219,6 +219,11 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
       ++m.n_lost;
       continue;
     }
+    if (spec.min_corner_jacobian > 0 && min_scaled_corner_jacobian(x) < spec.min_corner_jacobian) {
+      ++m.n_lost;
+      ++m.n_distorted;
+      continue;
+    }
     kept.push_back(e);
     std::array<std::int32_t, 8> h{};
     for (std::size_t k = 0; k < 8; ++k) {

@@ -35,6 +35,10 @@ struct TieSpec {
 
 struct TransferSpec {
   std::vector<int> parts;  // part ids of the tow hexahedra to take (empty: every tow hexahedron)
+  /// A draped hexahedron whose smallest scaled corner Jacobian is below this is not mapped: a
+  /// dry tow folded over a tool edge carries it, an impregnated one (a hundred times stiffer)
+  /// makes the one-point hexahedron unstable at once. [0, 0.5]; 0 keeps every unfolded one.
+  double min_corner_jacobian = 0.1;
   FibreData fibre;
   ResinData resin;
   double compressive_ratio = 0.6;
@@ -64,12 +68,13 @@ struct ImpregnatedModel {
   std::vector<TiePairs> ties;
   std::size_t n_candidates = 0;  // tow hexahedra in the source frame (selected parts)
   std::size_t n_trimmed = 0;     // left out by the trim
-  std::size_t n_lost = 0;      // not mapped: eroded in the drape, a non-positive volume, a fibre
-                               // along the thickness
-  std::size_t n_eroded = 0;    // of those, eroded in the drape
-  std::size_t n_capped = 0;    // Vf capped at the locking value
-  std::size_t n_floored = 0;   // Vf raised to the undeformed value (a tow the drape spread)
-  std::size_t n_stitches = 0;  // stitch bars in the source frame (dropped)
+  std::size_t n_lost = 0;        // not mapped: eroded in the drape, a non-positive volume, a fibre
+                                 // along the thickness
+  std::size_t n_eroded = 0;      // of those, eroded in the drape
+  std::size_t n_distorted = 0;   // of those, folded or distorted past spec.min_corner_jacobian
+  std::size_t n_capped = 0;      // Vf capped at the locking value
+  std::size_t n_floored = 0;     // Vf raised to the undeformed value (a tow the drape spread)
+  std::size_t n_stitches = 0;    // stitch bars in the source frame (dropped)
 
   std::size_t n_elements() const { return hex.size(); }
   std::size_t n_tie_pairs() const;

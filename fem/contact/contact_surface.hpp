@@ -21,12 +21,13 @@ struct ContactSurface {
   std::vector<double>
       seg_elem_thickness;  // [n_seg] owning hexahedron's thickness normal to the face at x0, m
   std::vector<std::int64_t> seg_elem_user_id;  // [n_seg] for messages
-  std::vector<std::int32_t> seg_hex;           // [n_seg] owning element (mesh-wide index, Mesh::element_offset)
+  std::vector<std::int32_t>
+      seg_hex;  // [n_seg] owning element (mesh-wide index, Mesh::element_offset)
   // [n_seg] -1: an outer face; else an inner face (only with interior_faces), covered by this
   // hexahedron of the same group: a surface segment only once that one is eroded.
   std::vector<std::int32_t> seg_cover_hex;
-  std::vector<std::int32_t> node;              // [n_snode] mesh node of each surface node
-  std::vector<std::int32_t> node_group;        // [n_snode] group of each surface node
+  std::vector<std::int32_t> node;        // [n_snode] mesh node of each surface node
+  std::vector<std::int32_t> node_group;  // [n_snode] group of each surface node
   std::vector<double>
       node_area;  // [n_snode] tributary area at x0 (quarter of each outer segment), m^2
 

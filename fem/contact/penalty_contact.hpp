@@ -120,7 +120,7 @@ class PenaltyContact final : public ContactAlgorithm {
                                             // sharing an edge, -1 padded
 
   // State and work arrays, sized in initialise(), reused every cycle.
-  std::vector<double> x_sorted_;           // [n_snode][3] positions at the last sort
+  std::vector<double> x_sorted_;  // [n_snode][3] positions at the last sort
   /// Contact state of a node facet carried from cycle to cycle (one record, not four arrays:
   /// the force pass reads and writes it for every facet).
   struct FacetState {
@@ -138,10 +138,10 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<FacetState> facet_state_old_;  // before the last sort (carried over)
   std::vector<std::int32_t> facet_start_;    // [n_snode + 1] first facet of each surface node
   std::vector<std::int32_t> facet_start_old_;
-  std::vector<double> node_mass_;          // [n_nodes] lumped nodal masses (fixed after set-up), kg
-  std::vector<std::int32_t> cand_start_;   // [n_snode + 1] CSR into cand_seg_ (at the sort)
-  std::vector<std::int32_t> cand_seg_;     // candidate segments, node by node
-  std::vector<std::uint8_t> cand_facet_;   // facet of the node each candidate faces
+  std::vector<double> node_mass_;         // [n_nodes] lumped nodal masses (fixed after set-up), kg
+  std::vector<std::int32_t> cand_start_;  // [n_snode + 1] CSR into cand_seg_ (at the sort)
+  std::vector<std::int32_t> cand_seg_;    // candidate segments, node by node
+  std::vector<std::uint8_t> cand_facet_;  // facet of the node each candidate faces
   // The candidates segment by segment (what the cycle reads): segments with candidates in
   // increasing order, CSR into ucand_ (mesh node and facet of each candidate, one record) and
   // ucand_node_ (its surface node, only for the closest-feature test).
@@ -162,20 +162,20 @@ class PenaltyContact final : public ContactAlgorithm {
     float n[3] = {0, 0, 0};  // the segment's unit normal
     std::int32_t seg = -1;   // -1: no contact this cycle
   };
-  std::vector<BestHit> best_;        // [n_facet]
-  std::vector<SegmentFrame> frame_;  // [n_blocks * kFrameLanes] all frames, made at the sort
-  std::vector<double> box_lo_, box_hi_;    // [n_seg][3] grown segment boxes at the sort
-  std::vector<double> facet_;              // [n_snode][kMaxFacets][3] facet normals at the sort
-  std::vector<std::uint8_t> n_facets_;     // [n_snode]
+  std::vector<BestHit> best_;            // [n_facet]
+  std::vector<SegmentFrame> frame_;      // [n_blocks * kFrameLanes] all frames, made at the sort
+  std::vector<double> box_lo_, box_hi_;  // [n_seg][3] grown segment boxes at the sort
+  std::vector<double> facet_;            // [n_snode][kMaxFacets][3] facet normals at the sort
+  std::vector<std::uint8_t> n_facets_;   // [n_snode]
   std::vector<std::int32_t> node_seg_start_, node_seg_;  // segments around each surface node (CSR)
-  std::vector<std::int32_t> active_seg_;  // [n_seg] index into segs of the grid (active groups)
-  std::vector<std::uint8_t> seg_eroded_;  // [n_seg] 1: its hexahedron was eroded
+  std::vector<std::int32_t> active_seg_;   // [n_seg] index into segs of the grid (active groups)
+  std::vector<std::uint8_t> seg_eroded_;   // [n_seg] 1: its hexahedron was eroded
   std::vector<std::uint8_t> seg_dormant_;  // [n_seg] 1: an inner face still covered (erosion)
   std::vector<std::uint8_t> seg_in_pair_;  // [n_seg] 1: its group is in a pair
   /// Rebuilds active_seg_: segments of paired groups neither eroded nor dormant.
   void collect_active_segments();
   bool seg_off(std::size_t s) const { return seg_eroded_[s] || seg_dormant_[s]; }
-  bool resort_ = false;                   // the surface changed: sort before the next cycle
+  bool resort_ = false;  // the surface changed: sort before the next cycle
   BucketGrid grid_;
 
   ContactBatch batch_;          // active contacts on their way through the force kernel

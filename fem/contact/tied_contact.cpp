@@ -65,6 +65,7 @@ void TiedContact::add_tie(std::int32_t node, const std::int32_t* corners, double
   xi_.push_back(xi);
   eta_.push_back(eta);
   offset_.insert(offset_.end(), off, off + 3);
+  for (int k = 0; k < 3; ++k) offset_global_.push_back(p[k] - tf.x[k]);
   stiffness_.push_back(cfg_.penalty_scale * m_s * m_m / (m_s + m_m) * inv_dt0_sq);
   normal_cap_.push_back(cfg_.normal_strength * area);
   shear_cap_.push_back(cfg_.shear_strength * area);
@@ -163,6 +164,7 @@ void TiedContact::initialise(const ContactSetup& setup) {
   if (!setup.mesh || !setup.x0 || !setup.mass || !(setup.dt > 0))
     throw InputError(cfg_.source_file, prefix, "contact set up without mesh, masses or step");
   node_.clear(), corner_.clear(), xi_.clear(), eta_.clear(), offset_.clear(), stiffness_.clear();
+  offset_global_.clear();
   normal_cap_.clear(), shear_cap_.clear(), seg_hex_.clear(), slave_hex_.clear(), area_.clear();
   cohesive_ = cfg_.mode_i_energy > 0;
   if (!cfg_.face_pairs.empty()) {
@@ -278,8 +280,17 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
     const double* o = &offset_[3 * t];
     const auto i = 3 * static_cast<std::size_t>(node_[t]);
     double d[3];
-    for (int k = 0; k < 3; ++k)
-      d[k] = x[i + k] - (tf.x[k] + o[0] * tf.t1[k] + o[1] * tf.t2[k] + o[2] * tf.n[k]);
+    if (cohesive_) {
+      // The separation from the tied point's displacement (a spring between the node and the
+      // master point, derived from a potential): an offset turned with the segment would pull
+      // the master segment round without the moment it makes, and with offsets as large as a
+      // tow's side face (the resin gap between tows) that fed energy into the model.
+      const double* g0 = &offset_global_[3 * t];
+      for (int k = 0; k < 3; ++k) d[k] = x[i + k] - tf.x[k] - g0[k];
+    } else {
+      for (int k = 0; k < 3; ++k)
+        d[k] = x[i + k] - (tf.x[k] + o[0] * tf.t1[k] + o[1] * tf.t2[k] + o[2] * tf.n[k]);
+    }
     const double k = stiffness_[t];
     const double dn = d[0] * tf.n[0] + d[1] * tf.n[1] + d[2] * tf.n[2];
     const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
@@ -295,11 +306,11 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
                             cfg_.bk_exponent};
       const double ds = std::sqrt(std::max(d2 - dn * dn, 0.0));
       CohesiveState& st = state_[t];
-      const double d_old = st.damage;
+      const double dissipated_old = st.dissipated;
       double tn = 0, ts = 0;
       cohesive_tractions(law, dn, ds, st, tn, ts);
       const double dnp = std::max(dn, 0.0);
-      released += 0.5 * (st.damage - d_old) * k * (dnp * dnp + ds * ds);
+      released += A * (st.dissipated - dissipated_old);
       if (alive_[t] == 2 || (st.damage >= 1.0 && dn >= 0)) {
         alive_[t] = 0;
         ++failed;

@@ -58,6 +58,7 @@ class TiedContact final : public ContactAlgorithm {
   std::vector<std::int32_t> corner_;   // [n_tie][4] master segment corners
   std::vector<double> xi_, eta_;       // [n_tie] local coordinates on the segment
   std::vector<double> offset_;         // [n_tie][3] initial offset along (t1, t2, n) of the segment
+  std::vector<double> offset_global_;  // [n_tie][3] initial offset, global (cohesive ties)
   std::vector<double> stiffness_;      // [n_tie] k, N/m
   std::vector<double> normal_cap_;     // [n_tie] tensile strength * area, N (0: none)
   std::vector<double> shear_cap_;      // [n_tie] shear strength * area, N (0: none)

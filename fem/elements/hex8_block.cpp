@@ -199,6 +199,10 @@ std::array<double, 3> hex8_axis_lengths(const double (&x)[8][3], const std::arra
   return L;
 }
 
+// Largest hourglass vector of a reference shape, relative to its smallest half edge, that still
+// counts as a parallelepiped for the directional step bound.
+constexpr double kParallelepipedTolerance = 0.1;
+
 void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double, 9>& part_axes,
                      const double* element_axes) {
   const std::size_t n = b.n;
@@ -272,6 +276,14 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
       const double lc0 = g.V / std::sqrt(max_face_area_sq(xe));
       b.step_length0[e] = lc0;
       b.step_modulus[e] = 2.0 * strain_operator_eigenvalue(C_step, Dm) * lc0 * lc0;
+      // The bound is exact for a parallelepiped only: a reference shape with hourglass content
+      // (tapered, warped: a formed part's tows at a fillet) takes the V / A_max bound, which a
+      // stiff fibre direction otherwise exceeded (an impregnated formed hemisphere blew up at
+      // rest).
+      double half_min = 1e300, hg_max = 0;
+      for (int k = 1; k < 4; ++k) half_min = std::min(half_min, std::sqrt(dot(g.a[k], g.a[k])));
+      for (int k = 4; k < 8; ++k) hg_max = std::max(hg_max, std::sqrt(dot(g.a[k], g.a[k])));
+      if (hg_max > kParallelepipedTolerance * half_min) b.step_modulus[e] = 0.0;
     }
     std::array<double, 9> T{};  // element axes in the material frame: T = M^T R
     for (int i = 0; i < 3; ++i)

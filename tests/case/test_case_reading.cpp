@@ -120,10 +120,10 @@ TEST(CaseTypeRegistry, DispatchesAMaterialTypeToItsReader) {
   EXPECT_EQ(material->density(), 1000.0);
 }
 
-TEST(CaseTypeRegistry, EngineCasesKnowDrapesTowLaw) {
+TEST(CaseTypeRegistry, EngineCasesKnowDrapesAndImpactsTowLaws) {
   const auto types = workflow::engine_case_types().material_types();
-  EXPECT_EQ(types,
-            (std::vector<std::string>{"elastic_isotropic", "elastic_orthotropic", "tow_biphase"}));
+  EXPECT_EQ(types, (std::vector<std::string>{"elastic_isotropic", "elastic_orthotropic",
+                                             "tow_biphase", "tow_damage"}));
 }
 
 TEST(CaseTypeRegistry, UnknownTypeNamesFileKeyAndTheAllowedTypes) {
@@ -137,7 +137,8 @@ TEST(CaseTypeRegistry, UnknownTypeNamesFileKeyAndTheAllowedTypes) {
     EXPECT_EQ(e.file(), file.string());
     EXPECT_EQ(e.key(), "material[0].type");
     EXPECT_EQ(e.value(), "rubber");
-    EXPECT_EQ(e.allowed(), "'elastic_isotropic', 'elastic_orthotropic', 'tow_biphase'");
+    EXPECT_EQ(e.allowed(),
+              "'elastic_isotropic', 'elastic_orthotropic', 'tow_biphase', 'tow_damage'");
     const std::string what = e.what();
     EXPECT_NE(what.find(file.string()), std::string::npos) << what;
     EXPECT_NE(what.find("'material[0].type'"), std::string::npos) << what;

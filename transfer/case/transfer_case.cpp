@@ -81,6 +81,8 @@ TransferCase load_transfer_case(const std::filesystem::path& file,
     spec.mapping.vf_bin = im->number("vf_bin", spec.mapping.vf_bin, Range::open_closed(0, 0.1));
     spec.compressive_ratio =
         im->number("compressive_ratio", spec.compressive_ratio, Range::open_closed(0, 1.5));
+    spec.min_corner_jacobian =
+        im->number("min_corner_jacobian", spec.min_corner_jacobian, Range::closed(0, 0.5));
   }
   if (auto t = root.table("trim")) {
     spec.trim.radius = t->number("radius", 0.0, Range::non_negative());

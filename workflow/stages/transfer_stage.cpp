@@ -244,9 +244,11 @@ int run_transfer_stage(const StageCall& call) {
   for (const auto& t : m.ties) log->info("tied {}: {} face pairs", t.name, t.slave.size());
   if (m.n_lost)
     log->warn(
-        "{} tow hexahedra not mapped: {} eroded in the drape, {} with a non-positive volume or "
-        "the fibre along the thickness",
-        m.n_lost, m.n_eroded, m.n_lost - m.n_eroded);
+        "{} tow hexahedra not mapped: {} eroded in the drape, {} folded or distorted (smallest "
+        "scaled corner Jacobian below impregnation.min_corner_jacobian = {:g}), {} with a "
+        "non-positive volume or the fibre along the thickness",
+        m.n_lost, m.n_eroded, m.n_distorted, tc.spec.min_corner_jacobian,
+        m.n_lost - m.n_eroded - m.n_distorted);
 
   if (tc.frames_xdmf) write_results(dir, m);
   write_file_atomically(dir / "materials.csv", materials_csv(m));
@@ -260,6 +262,7 @@ int run_transfer_stage(const StageCall& call) {
   s["elements_mapped"] = m.n_elements();
   s["elements_lost"] = m.n_lost;
   s["elements_lost_eroded"] = m.n_eroded;
+  s["elements_lost_distorted"] = m.n_distorted;
   s["elements_trimmed"] = m.n_trimmed;
   s["vf_min"] = vf_min;
   s["vf_max"] = vf_max;
