@@ -144,7 +144,10 @@ void CrushMeasure::add_summary(const fem::ExplicitSolver& s, nlohmann::json& sum
   summary["cfc_class"] = cfc_;
   summary["peak_force_N"] = fem::json_number(peak);
   summary["peak_force_filtered"] = why_raw.empty();
-  if (!why_raw.empty()) summary["peak_force_unfiltered_because"] = why_raw;
+  if (!why_raw.empty())
+    summary["peak_force_unfiltered_because"] = why_raw;
+  else
+    summary.erase("peak_force_unfiltered_because");  // written at an early frame
   summary["peak_force_raw_N"] = fem::json_number(peak_raw);
   summary["stroke_at_peak_m"] = fem::json_number(at_peak);
   summary["stroke_m"] = stroke_.empty() ? nlohmann::json(nullptr) : nlohmann::json(stroke_.back());

@@ -174,6 +174,10 @@ void TiedContact::initialise(const ContactSetup& setup) {
                        "no slave node lies within the search distance of its paired master faces");
     alive_.assign(node_.size(), 1);
     state_.assign(node_.size(), CohesiveState{});
+    tie_work_.assign(node_.size(), 0.0);
+    failed_work_ = 0;
+    last_sep_.assign(3 * node_.size(), 0.0);
+    last_force_.assign(3 * node_.size(), 0.0);
     n_alive_ = static_cast<std::int64_t>(node_.size());
     dissipation_ = 0;
     force_ = {};
@@ -249,6 +253,10 @@ void TiedContact::initialise(const ContactSetup& setup) {
                      "no slave node lies within " + std::to_string(r) + " m of the master surface");
   alive_.assign(node_.size(), 1);
   state_.assign(node_.size(), CohesiveState{});
+  tie_work_.assign(node_.size(), 0.0);
+  failed_work_ = 0;
+  last_sep_.assign(3 * node_.size(), 0.0);
+  last_force_.assign(3 * node_.size(), 0.0);
   n_alive_ = static_cast<std::int64_t>(node_.size());
   dissipation_ = 0;
   force_ = {};
@@ -269,7 +277,7 @@ double TiedContact::failed_area() const {
 
 void TiedContact::add_forces(const double* x, const double*, const double*, double, double* f) {
   const std::size_t n = node_.size();
-  double Rx = 0, Ry = 0, Rz = 0, released = 0;
+  double Rx = 0, Ry = 0, Rz = 0, released = 0, alive_dissipation = 0;
   std::int64_t failed = 0;
   for (std::size_t t = 0; t < n; ++t) {
     if (!alive_[t]) continue;
@@ -306,22 +314,32 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
                             cfg_.bk_exponent};
       const double ds = std::sqrt(std::max(d2 - dn * dn, 0.0));
       CohesiveState& st = state_[t];
-      const double dissipated_old = st.dissipated;
       double tn = 0, ts = 0;
       cohesive_tractions(law, dn, ds, st, tn, ts);
       const double dnp = std::max(dn, 0.0);
-      released += A * (st.dissipated - dissipated_old);
-      if (alive_[t] == 2 || (st.damage >= 1.0 && dn >= 0)) {
+      // Work on the tie over the last step (force on the slave node, trapezoidal), then what it
+      // still holds: the rest of its work is dissipated (damage; all of it once it has failed).
+      double* ls = &last_sep_[3 * t];
+      double* lf = &last_force_[3 * t];
+      double Fv[3];
+      const bool failing = alive_[t] == 2 || (st.damage >= 1.0 && dn >= 0);
+      const double is = ds > 0 ? ts * A / ds : 0.0;
+      for (int c = 0; c < 3; ++c)
+        Fv[c] = failing ? 0.0 : -(tn * A * tf.n[c] + is * (d[c] - dn * tf.n[c]));
+      for (int c = 0; c < 3; ++c) {
+        tie_work_[t] -= 0.5 * (lf[c] + Fv[c]) * (d[c] - ls[c]);
+        ls[c] = d[c], lf[c] = Fv[c];
+      }
+      if (failing) {
         alive_[t] = 0;
         ++failed;
-        released +=
-            0.5 * (1 - st.damage) * k * (dnp * dnp + ds * ds) + (dn < 0 ? 0.5 * k * dn * dn : 0.0);
+        failed_work_ += tie_work_[t];
         continue;
       }
-      // Force on the slave node: -A (tn n + ts s), s the sliding direction.
-      double Fv[3];
-      const double is = ds > 0 ? ts * A / ds : 0.0;
-      for (int c = 0; c < 3; ++c) Fv[c] = -(tn * A * tf.n[c] + is * (d[c] - dn * tf.n[c]));
+      // Held: the damaged springs of the opening and sliding, the undamaged one of a closing.
+      const double dnc = std::min(dn, 0.0);
+      alive_dissipation += tie_work_[t] - 0.5 * A * law.K *
+                                              ((1 - st.damage) * (dnp * dnp + ds * ds) + dnc * dnc);
       f[i] += Fv[0], f[i + 1] += Fv[1], f[i + 2] += Fv[2];
       for (int a = 0; a < 4; ++a) {
         const auto j = 3 * static_cast<std::size_t>(corner_[4 * t + a]);
@@ -351,6 +369,7 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
   }
   n_alive_ -= failed;
   dissipation_ += released;
+  if (cohesive_) dissipation_ = failed_work_ + alive_dissipation;
   force_ = {Rx, Ry, Rz};
 }
 

@@ -66,6 +66,10 @@ class TiedContact final : public ContactAlgorithm {
   std::vector<std::int32_t> slave_hex_;  // [n_tie] a hexahedron of the slave face (-1: unknown)
   std::vector<double> area_;             // [n_tie] tributary area, m^2
   std::vector<CohesiveState> state_;     // [n_tie] cohesive state (cohesive ties)
+  // Cohesive ties: the work done on each tie (trapezoidal in its separation) and the separation
+  // and force of the last cycle; what a tie dissipated is its work less the energy it holds.
+  std::vector<double> tie_work_, last_sep_, last_force_;
+  double failed_work_ = 0;  // work done on the ties that have failed (all dissipated)
   std::vector<std::uint8_t> alive_;      // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
   std::int64_t n_alive_ = 0;
   double dissipation_ = 0;

@@ -121,8 +121,11 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
                tr.string(), "--set", "source.results=" + (out / "results.h5").string()});
   ASSERT_EQ(tr_run.code, 0) << tr_run.output;
   const auto ts = nlohmann::json::parse(slurp(tr / "summary.json"));
-  // Every tow element that was not eroded (an eroded one has no shape to map).
-  EXPECT_EQ(ts["elements_lost"], s["eroded_elements"]);
+  // Every tow element that was not eroded (an eroded one has no shape to map) nor folded over a
+  // tool edge (a handful: a folded impregnated tow would make the crush unstable).
+  EXPECT_EQ(ts["elements_lost"].get<std::size_t>(),
+            s["eroded_elements"].get<std::size_t>() + ts["elements_lost_distorted"].get<std::size_t>());
+  EXPECT_LE(ts["elements_lost_distorted"].get<std::size_t>(), hexes / 200);
   EXPECT_EQ(ts["elements_mapped"].get<std::size_t>() + ts["elements_lost"].get<std::size_t>(),
             hexes);
   EXPECT_GE(ts["vf_min"].get<double>(), 0.6 - 1e-12);
@@ -131,6 +134,48 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   EXPECT_GT(ts["tie_pairs_interply"].get<std::size_t>(),
             s["elements"]["hex8"].get<std::size_t>() / 4);
   EXPECT_GT(ts["tie_pairs_intraply"].get<std::size_t>(), 0u);
+
+  // The crush (issue #21) of the dome trimmed at r = 76 mm: 3 mm of stroke at 1.5 m/s. The CI
+  // mesh's 6.6 mm tow elements need fracture energies 1.4-3x the literature's (the crack band's
+  // snap-back limit; the default mesh takes cases/hemisphere/crush.toml's).
+  const fs::path dome = out / "transfer_dome", crush = out / "crush";
+  const auto dome_run =
+      run_cli({"-q", "run", (kSource / "cases/hemisphere/transfer_dome.toml").string(), "-o",
+               dome.string(), "--set", "source.results=" + (out / "results.h5").string()});
+  ASSERT_EQ(dome_run.code, 0) << dome_run.output;
+  const auto crush_run = run_cli(
+      {"-q", "run", (kSource / "cases/hemisphere/crush.toml").string(), "-o", crush.string(),
+       "--set", "model.source=" + (dome / "results.h5").string(), "--set",
+       "model.damage.fracture_energy.fibre_tension=300000.0", "--set",
+       "model.damage.fracture_energy.fibre_compression=110000.0", "--set",
+       "model.damage.fracture_energy.matrix_tension=1400.0", "--set",
+       "model.damage.fracture_energy.transverse_shear=1600.0", "--set", "time.end_time=0.0022",
+       "--set", "time.energy_balance_limit=0.1", "--set", "output.figures=false", "--set",
+       "output.report=false"});
+  ASSERT_EQ(crush_run.code, 0) << crush_run.output;
+  const auto cs = nlohmann::json::parse(slurp(crush / "summary.json"));
+  EXPECT_EQ(cs["stage"], "crush");
+  ASSERT_TRUE(cs["peak_force_N"].is_number());
+  EXPECT_GT(cs["peak_force_N"].get<double>(), 50.0);
+  EXPECT_LT(cs["peak_force_N"].get<double>(), 5000.0);
+  EXPECT_GT(cs["energy_absorbed_J"].get<double>(), 0.0);
+  EXPECT_GT(cs["stroke_at_peak_m"].get<double>(), 0.0);
+  // The goal is 5 %; this session's run closed at 5.0 % (docs/fabric-data.md, "Crush").
+  EXPECT_LT(cs["energy_balance_error"].get<double>(), 0.08);
+  EXPECT_LT(cs["punch_max_penetration_m"].get<double>(), 0.1 * 0.23e-3) << "the punch sinks in";
+  double failed = 0;
+  for (const char* m : {"fibre_tension", "fibre_compression", "matrix_tension",
+                        "matrix_compression", "in_plane_shear", "transverse_shear"})
+    failed += cs[std::string("failed_fraction_") + m].get<double>();
+  EXPECT_GT(failed, 0.0) << "no tow failed in 3 mm of crush";
+  const History ch = read_history(crush / "history.csv");
+  const std::size_t filtered = ch.column("punch_force_cfc600_N");
+  ASSERT_LT(filtered, ch.columns.size());
+  const std::size_t raw = ch.column("punch_force_N");
+  for (const auto& row : ch.rows) {
+    ASSERT_TRUE(std::isfinite(row[raw]));
+    ASSERT_TRUE(std::isfinite(row[filtered]));
+  }
   fs::remove_all(out);
 }
 

@@ -22,7 +22,7 @@ std::string element_counts(const fem::ExplicitSolver& s) {
 json summary_header(const EngineCase& ec, const RunOptions& options) {
   json summary;
   summary["case"] = ec.name;
-  summary["stage"] = "engine";
+  summary["stage"] = ec.kind.empty() ? "engine" : ec.kind;  // engine or crush
   summary["ncfsim_version"] = kVersion;
   summary["case_file"] = ec.file.string();
   summary["overrides"] = options.overrides;
