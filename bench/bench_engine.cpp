@@ -1,9 +1,10 @@
 // Engine throughput (issue #2, item 8): ns per element-cycle on one core.
 //
 //   HexFullCycle/<material>/<numbering>  full ExplicitSolver::step() cycles on a 60x50x40 block of
-//                                        120,000 hexahedra (base fixed, non-uniform velocity field):
-//                                        internal force (geometry, strain, material, Cauchy stress,
-//                                        hourglass, scatter), loads, nodal update, positions
+//                                        120,000 hexahedra (base fixed, non-uniform velocity
+//                                        field): internal force (geometry, strain, material, Cauchy
+//                                        stress, hourglass, scatter), loads, nodal update,
+//                                        positions
 //   HexInternalForceOnly/<material>      hex8_internal_forces alone on the same block;
 //                                        ".../l2_resident": a 2,048-element block whose state stays
 //                                        in L2 (the compute-bound figure, for reference)
@@ -18,6 +19,7 @@
 // descheduled on a shared machine is not counted; wall_* the same from wall time. Each benchmark
 // runs a fixed number of cycles, 3 repetitions; mean, median, min are reported. < 1 min in all.
 #include <benchmark/benchmark.h>
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -27,22 +29,22 @@
 #include <numeric>
 #include <random>
 #include <string>
-#include <time.h>
 
 #include "fem/elements/hex8_block.hpp"
 #include "fem/model.hpp"
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
+#include "impact/tow_damage_material.hpp"
 
 using namespace ncfsim;
 
 namespace {
 
-enum class Mat { Isotropic, Orthotropic };
+enum class Mat { Isotropic, Orthotropic, TowDamage };
 enum class Numbering { Local, RandomNodes, RandomAll };
 
-constexpr std::array<int, 3> kHexDiv{60, 50, 40};  // 120,000 hexahedra, h = 10 mm
-constexpr std::array<int, 3> kSmallHexDiv{16, 16, 8};  // 2,048 hexahedra: state stays in L2
+constexpr std::array<int, 3> kHexDiv{60, 50, 40};        // 120,000 hexahedra, h = 10 mm
+constexpr std::array<int, 3> kSmallHexDiv{16, 16, 8};    // 2,048 hexahedra: state stays in L2
 constexpr std::array<int, 3> kLatticeNodes{40, 40, 26};  // 121,120 bars, 10 mm apart
 
 struct Fixture {
@@ -63,7 +65,8 @@ void shuffle_numbering(fem::Mesh& mesh, bool elements, std::mt19937_64& rng) {
   std::shuffle(new_of_old.begin(), new_of_old.end(), rng);
   std::vector<double> coords(mesh.coords.size());
   for (std::size_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) coords[3 * static_cast<std::size_t>(new_of_old[i]) + k] = mesh.coords[3 * i + k];
+    for (int k = 0; k < 3; ++k)
+      coords[3 * static_cast<std::size_t>(new_of_old[i]) + k] = mesh.coords[3 * i + k];
   mesh.coords.swap(coords);
   for (auto& set : mesh.sets)
     for (auto& v : set.conn) v = new_of_old[static_cast<std::size_t>(v)];
@@ -98,14 +101,16 @@ void set_velocity_field(fem::ExplicitSolver& s, double v0, bool noise) {
   const auto& m = s.model().mesh;
   std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   for (std::size_t i = 0; i < m.n_nodes(); ++i)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.coords[3 * i + k]), hi[k] = std::max(hi[k], m.coords[3 * i + k]);
+    for (int k = 0; k < 3; ++k)
+      lo[k] = std::min(lo[k], m.coords[3 * i + k]), hi[k] = std::max(hi[k], m.coords[3 * i + k]);
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   auto V = s.v.view();
   auto X = s.x.view();
   constexpr double pi = std::numbers::pi;
   for (std::size_t i = 0; i < m.n_nodes(); ++i) {
-    const double x = (X[3 * i] - lo[0]) / (hi[0] - lo[0]), y = (X[3 * i + 1] - lo[1]) / (hi[1] - lo[1]),
+    const double x = (X[3 * i] - lo[0]) / (hi[0] - lo[0]),
+                 y = (X[3 * i + 1] - lo[1]) / (hi[1] - lo[1]),
                  z = (X[3 * i + 2] - lo[2]) / (hi[2] - lo[2]);
     const double r = noise ? 0.02 : 0.0;
     V[3 * i] = v0 * (std::sin(pi * z) * std::cos(pi * y) + 0.3 * x + r * u(rng));
@@ -116,7 +121,8 @@ void set_velocity_field(fem::ExplicitSolver& s, double v0, bool noise) {
 }
 
 Fixture& hex_fixture(Mat mat, Numbering num, bool small = false) {
-  const std::string key = "hex" + std::to_string(int(mat)) + std::to_string(int(num)) + (small ? "s" : "");
+  const std::string key =
+      "hex" + std::to_string(int(mat)) + std::to_string(int(num)) + (small ? "s" : "");
   if (g_fixture && g_fixture->key == key) return *g_fixture;
   g_fixture.reset();
   auto fx = std::make_unique<Fixture>();
@@ -132,7 +138,19 @@ Fixture& hex_fixture(Mat mat, Numbering num, bool small = false) {
   } else {
     // Carbon/epoxy-like, fibre axes turned 30 degrees about z.
     const fem::OrthotropicConstants c{135e9, 10e9, 10e9, 0.3, 0.3, 0.45, 5e9, 5e9, 3.5e9};
-    model.materials.push_back(std::make_unique<fem::ElasticOrthotropic>("cfrp", 1550.0, c));
+    if (mat == Mat::Orthotropic) {
+      model.materials.push_back(std::make_unique<fem::ElasticOrthotropic>("cfrp", 1550.0, c));
+    } else {
+      // The same tow with the impregnated-tow damage law (issue #21): initiation per mode and
+      // crack-band softening evaluated for every element every cycle.
+      impact::TowDamageConstants d;
+      d.density = 1550.0;
+      d.elastic = c;
+      d.strength = {2.3e9, 1.4e9, 60e6, 36e6, 80e6, 60e6};
+      d.fracture_energy = {9e5, 8e5, 3e3, 8e3, 8e3, 5e3};  // J/m^2: no snap-back at h = 10 mm
+      d.default_length = 0.01;
+      model.materials.push_back(std::make_unique<impact::TowDamageMaterial>("cfrp_damage", d));
+    }
     const double a = std::numbers::pi / 6, ca = std::cos(a), sa = std::sin(a);
     model.parts[0].material_axes = {ca, -sa, 0, sa, ca, 0, 0, 0, 1};
   }
@@ -189,7 +207,8 @@ Fixture& bar_fixture(const std::string& use) {
   for (std::size_t i = 0; i < mesh.n_nodes(); ++i) {
     bool on = false;
     for (int k = 0; k < 3; ++k) {
-      const double xk = mesh.coords[3 * i + k], hi = h * (kLatticeNodes[static_cast<std::size_t>(k)] - 1);
+      const double xk = mesh.coords[3 * i + k],
+                   hi = h * (kLatticeNodes[static_cast<std::size_t>(k)] - 1);
       on = on || xk < 1e-9 || xk > hi - 1e-9;
     }
     if (on) boundary.push_back(static_cast<std::int32_t>(i));
@@ -221,17 +240,23 @@ struct Timer {
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
   }
-  static double wall() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+  static double wall() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
   double c0 = cpu(), w0 = wall();
 };
 
 // ns_per_*_cycle from thread CPU time, wall_ns_per_*_cycle from wall time.
-void report(benchmark::State& state, const std::string& name, const Timer& t, std::size_t element_cycles_per_iteration) {
+void report(benchmark::State& state, const std::string& name, const Timer& t,
+            std::size_t element_cycles_per_iteration) {
   const double cpu = Timer::cpu() - t.c0, wall = Timer::wall() - t.w0;
-  const double ec = static_cast<double>(state.iterations()) * static_cast<double>(element_cycles_per_iteration);
+  const double ec =
+      static_cast<double>(state.iterations()) * static_cast<double>(element_cycles_per_iteration);
   state.counters[name] = benchmark::Counter(1e9 * cpu / ec);
   state.counters["wall_" + name] = benchmark::Counter(1e9 * wall / ec);
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(element_cycles_per_iteration));
+  state.SetItemsProcessed(state.iterations() *
+                          static_cast<std::int64_t>(element_cycles_per_iteration));
 }
 
 void BM_HexFullCycle(benchmark::State& state, Mat mat, Numbering num) {
@@ -294,22 +319,42 @@ void BM_BarInternalForceOnly(benchmark::State& state) {
 double min_of(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
 
 void common(benchmark::internal::Benchmark* b, int iterations) {
-  b->Iterations(iterations)->Repetitions(3)->ReportAggregatesOnly(true)->Unit(benchmark::kMillisecond);
+  b->Iterations(iterations)
+      ->Repetitions(3)
+      ->ReportAggregatesOnly(true)
+      ->Unit(benchmark::kMillisecond);
   b->ComputeStatistics("min", min_of);
 }
 
 void register_all() {
   using benchmark::RegisterBenchmark;
-  common(RegisterBenchmark("HexFullCycle/isotropic/local", BM_HexFullCycle, Mat::Isotropic, Numbering::Local), 40);
-  common(RegisterBenchmark("HexFullCycle/orthotropic/local", BM_HexFullCycle, Mat::Orthotropic, Numbering::Local), 40);
+  common(RegisterBenchmark("HexFullCycle/isotropic/local", BM_HexFullCycle, Mat::Isotropic,
+                           Numbering::Local),
+         40);
+  common(RegisterBenchmark("HexFullCycle/orthotropic/local", BM_HexFullCycle, Mat::Orthotropic,
+                           Numbering::Local),
+         40);
+  common(RegisterBenchmark("HexFullCycle/tow_damage/local", BM_HexFullCycle, Mat::TowDamage,
+                           Numbering::Local),
+         40);
   common(RegisterBenchmark("HexFullCycle/isotropic/random_nodes", BM_HexFullCycle, Mat::Isotropic,
-                           Numbering::RandomNodes), 40);
+                           Numbering::RandomNodes),
+         40);
   common(RegisterBenchmark("HexFullCycle/isotropic/random_all", BM_HexFullCycle, Mat::Isotropic,
-                           Numbering::RandomAll), 40);
-  common(RegisterBenchmark("HexInternalForceOnly/isotropic", BM_HexInternalForceOnly, Mat::Isotropic, false), 40);
-  common(RegisterBenchmark("HexInternalForceOnly/orthotropic", BM_HexInternalForceOnly, Mat::Orthotropic, false), 40);
-  common(RegisterBenchmark("HexInternalForceOnly/isotropic/l2_resident", BM_HexInternalForceOnly, Mat::Isotropic,
-                           true), 40);
+                           Numbering::RandomAll),
+         40);
+  common(RegisterBenchmark("HexInternalForceOnly/isotropic", BM_HexInternalForceOnly,
+                           Mat::Isotropic, false),
+         40);
+  common(RegisterBenchmark("HexInternalForceOnly/orthotropic", BM_HexInternalForceOnly,
+                           Mat::Orthotropic, false),
+         40);
+  common(RegisterBenchmark("HexInternalForceOnly/tow_damage", BM_HexInternalForceOnly,
+                           Mat::TowDamage, false),
+         40);
+  common(RegisterBenchmark("HexInternalForceOnly/isotropic/l2_resident", BM_HexInternalForceOnly,
+                           Mat::Isotropic, true),
+         40);
   common(RegisterBenchmark("BarFullCycle", BM_BarFullCycle), 200);
   common(RegisterBenchmark("BarInternalForceOnly", BM_BarInternalForceOnly), 200);
 }

@@ -19,6 +19,9 @@ TowDamageMaterial::TowDamageMaterial(std::string name, const TowDamageConstants&
     : name_(std::move(name)), c_(c) {
   require_positive(c.density, "density");
   require_positive(c.default_length, "default_length");
+  if (!(c.residual_compression >= 0 && c.residual_compression < 1))
+    throw std::invalid_argument("residual_compression: must be in [0, 1) (got " +
+                                std::to_string(c.residual_compression) + ")");
   const auto& s = c.strength;
   strength_ = {s.Xt, s.Xc, s.Yt, s.Yc, s.S12, s.S23};
   static constexpr std::array<const char*, kModes> kStrengthNames{"Xt", "Xc",  "Yt",
@@ -86,9 +89,12 @@ void TowDamageMaterial::update_stress(const fem::MaterialBatch& b) const {
     const double d3 = S[2] >= 0 ? d[2] : d[3];
     const double keep_axial_shear = (1 - d[4]) * (1 - d[2]) * (1 - d[0]);
     const double keep_transverse_shear = (1 - d[5]) * (1 - d[2]);
-    sig[e] = (1 - d1) * S[0];
-    sig[s + e] = (1 - d2) * S[1];
-    sig[2 * s + e] = (1 - d3) * S[2];
+    // Crushed in compression: at least the residual plateau (0 unless given).
+    const double R1 = c_.residual_compression * strength_[1],
+                 R2 = c_.residual_compression * strength_[3];
+    sig[e] = S[0] < 0 ? std::min((1 - d1) * S[0], -std::min(-S[0], R1)) : (1 - d1) * S[0];
+    sig[s + e] = S[1] < 0 ? std::min((1 - d2) * S[1], -std::min(-S[1], R2)) : (1 - d2) * S[1];
+    sig[2 * s + e] = S[2] < 0 ? std::min((1 - d3) * S[2], -std::min(-S[2], R2)) : (1 - d3) * S[2];
     sig[3 * s + e] = keep_axial_shear * S[3];
     sig[4 * s + e] = keep_transverse_shear * S[4];
     sig[5 * s + e] = keep_axial_shear * S[5];

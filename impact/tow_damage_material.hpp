@@ -14,6 +14,7 @@
 //   strength and dissipates G_m / L_m per volume whatever the mesh. r_f must exceed 1: the element
 //   must be short enough not to snap back, L_m < 2 G_m E_m / X_m^2 (checked).
 //   degradation: s11 (1 - d_ft or d_fc by its sign), s22 and s33 (1 - d_mt or d_mc by their signs),
+//   a compressive one held at least at min(|C E|, residual_compression x Xc or Yc) (crush plateau),
 //   s12 and s13 (1 - d_s12)(1 - d_mt)(1 - d_ft): a cracked matrix and broken fibres carry no axial
 //   shear; s23 (1 - d_s23)(1 - d_mt).
 // History per element [kHistory][stride]: total strain (6), r per mode (6), d per mode (6), failed
@@ -58,6 +59,11 @@ struct TowDamageConstants {
   /// modes (a tow whose matrix has cracked still carries its fibres).
   std::array<bool, kModes> erode_on{true, true, false, false, false, false};
   std::string fracture_energy_key;  // case-file key of the fracture energies, for messages
+  /// Share of the compressive strength (Xc along the fibres, Yc across) a fully crushed tow still
+  /// carries, [0, 1): its compressive stress never falls below min(|C E|, share x strength). A
+  /// crushed composite keeps bearing (the crush plateau); with 0 a tow failed in compression
+  /// carries nothing and collapses under a punch. Elastic on the way back (no energy created).
+  double residual_compression = 0;
 };
 
 class TowDamageMaterial final : public fem::SolidMaterial {

@@ -338,8 +338,8 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
       }
       // Held: the damaged springs of the opening and sliding, the undamaged one of a closing.
       const double dnc = std::min(dn, 0.0);
-      alive_dissipation += tie_work_[t] - 0.5 * A * law.K *
-                                              ((1 - st.damage) * (dnp * dnp + ds * ds) + dnc * dnc);
+      alive_dissipation +=
+          tie_work_[t] - 0.5 * A * law.K * ((1 - st.damage) * (dnp * dnp + ds * ds) + dnc * dnc);
       f[i] += Fv[0], f[i + 1] += Fv[1], f[i + 2] += Fv[2];
       for (int a = 0; a < 4; ++a) {
         const auto j = 3 * static_cast<std::size_t>(corner_[4 * t + a]);

@@ -28,6 +28,7 @@ void read_damage_keys(const TableReader& t, TowDamageConstants& c) {
     c.fracture_energy[static_cast<std::size_t>(m)] =
         fe.number(kModeNames[static_cast<std::size_t>(m)], Range::positive());
   c.fracture_energy_key = t.key_path("fracture_energy");
+  c.residual_compression = t.number("residual_compression", 0.0, Range{0, 1, false, true});
   if (t.has("erode_on")) {
     c.erode_on.fill(false);
     for (const auto& name : t.strings("erode_on")) {

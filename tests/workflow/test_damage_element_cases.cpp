@@ -69,6 +69,20 @@ TEST(CliVerificationDamage, TransverseShearPeaksAtS23AndDissipatesGOverL) {
   check_mode({"transverse_shear", "23", 60e6, 500});
 }
 
+// A crushed tow keeps a residual compressive strength when the material gives one: pushed far
+// past full matrix-compression damage, S22 stays at residual_compression x Yc (0.5 x 36 MPa).
+TEST(CliVerificationDamage, CrushedTowHoldsItsResidualCompressiveStrength) {
+  const fs::path out = fresh_dir("damage_residual");
+  const auto r = run_cli({"-q", "run",
+                          (kSource / "cases/verification/damage/matrix_compression.toml").string(),
+                          "-o", out.string(), "--set", "material[0].residual_compression=0.5"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const History h = read_history(out / "history.csv");
+  const double s22 = h.rows.back()[h.column("element_stress_22_Pa")];
+  EXPECT_NEAR(s22 / (-0.5 * 0.6 * 60e6), 1.0, 0.005);
+  fs::remove_all(out);
+}
+
 // A fracture energy too small for the element (snap-back: the crack band needs L < 2 G E / X^2)
 // is bad input naming the key and the limit; so are a zero strength and a negative energy.
 TEST(CliVerificationDamage, RefusesSnapBackAndNonPositiveData) {
