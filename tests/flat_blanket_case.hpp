@@ -1,4 +1,5 @@
 #pragma once
+#include <string>
 // A flat 60 x 60 mm +-45 NCF blanket (the CI mesh: one element across a tow, two pitches long)
 // with the default dry-tow law and a linear stitch: the body of a case file, without [case]; tests
 // append their [case], [time], [output] and probes.
@@ -33,6 +34,16 @@ tension_only = true
 linear_density = 7.6e-6
 strain = [0.0, 0.1]
 force = [0.0, 2.0]
+)";
+
+/// The blanket run for a few cycles (nearly undeformed, no figures): a drape result for the
+/// stages downstream (transfer, crush) to start from.
+inline const std::string kFlatBlanketBriefRun =
+    std::string("[case]\nname = \"flat_blanket\"\n") + kFlatBlanketBody + R"(
+[time]
+end_time = 2e-6
+[output]
+figures = false
 )";
 
 }  // namespace ncfsim::test

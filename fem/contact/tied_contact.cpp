@@ -39,6 +39,23 @@ inline void tie_frame(const double (&p)[4][3], double xi, double eta, TieFrame& 
   f.t2[2] = f.n[0] * f.t1[1] - f.n[1] * f.t1[0];
 }
 
+// Squared distance from p to the nearest point of the segment with corners c (reference
+// positions x0), its local coordinates clamped to the segment.
+inline double closest_on_segment(const double* x0, const std::int32_t* c, const double* p,
+                                 double& xi, double& eta) {
+  double q[4][3];
+  gather_segment(x0, c, q);
+  SegmentFrame f;
+  segment_frame(q, 0, f);
+  const SegmentProjection pr = project_on_segment(f, p[0], p[1], p[2]);
+  xi = std::clamp(pr.xi, -1.0, 1.0), eta = std::clamp(pr.eta, -1.0, 1.0);
+  TieFrame tf;
+  tie_frame(q, xi, eta, tf);
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) d2 += (p[k] - tf.x[k]) * (p[k] - tf.x[k]);
+  return d2;
+}
+
 }  // namespace
 
 TiedContact::TiedContact(TiedContactConfig config) : cfg_(std::move(config)) { validate(cfg_); }
@@ -137,16 +154,8 @@ void TiedContact::initialise_face_pairs(const ContactSetup& setup) {
       std::int32_t c[4];
       face_nodes(pr.master_hex, pr.master_face, c);
       if (std::find(c, c + 4, node) != c + 4) continue;
-      double q[4][3];
-      gather_segment(x0, c, q);
-      SegmentFrame f;
-      segment_frame(q, 0, f);
-      const SegmentProjection pj = project_on_segment(f, p[0], p[1], p[2]);
-      const double xi = std::clamp(pj.xi, -1.0, 1.0), eta = std::clamp(pj.eta, -1.0, 1.0);
-      TieFrame tf;
-      tie_frame(q, xi, eta, tf);
-      double d2 = 0;
-      for (int k = 0; k < 3; ++k) d2 += (p[k] - tf.x[k]) * (p[k] - tf.x[k]);
+      double xi = 0, eta = 0;
+      const double d2 = closest_on_segment(x0, c, p, xi, eta);
       if (d2 <= best_d2) {
         best_d2 = d2, bxi = xi, beta = eta, best_hex = pr.master_hex;
         std::copy(c, c + 4, best_c);
@@ -232,16 +241,8 @@ void TiedContact::initialise(const ContactSetup& setup) {
       const auto s = static_cast<std::size_t>(master_seg[a]);
       const std::int32_t* cn = &surf.seg_nodes[4 * s];
       if (std::find(cn, cn + 4, node) != cn + 4) continue;  // shares the node: already joined
-      double q[4][3];
-      gather_segment(x0, cn, q);
-      SegmentFrame f;
-      segment_frame(q, 0, f);
-      const SegmentProjection pr = project_on_segment(f, p[0], p[1], p[2]);
-      const double xi = std::clamp(pr.xi, -1.0, 1.0), eta = std::clamp(pr.eta, -1.0, 1.0);
-      TieFrame tf;
-      tie_frame(q, xi, eta, tf);
-      double d2 = 0;
-      for (int k = 0; k < 3; ++k) d2 += (p[k] - tf.x[k]) * (p[k] - tf.x[k]);
+      double xi = 0, eta = 0;
+      const double d2 = closest_on_segment(x0, cn, p, xi, eta);
       if (d2 <= best_d2) best_d2 = d2, best = static_cast<std::int32_t>(s), bxi = xi, beta = eta;
     }
     if (best < 0) continue;

@@ -20,13 +20,7 @@
 namespace ncfsim::test {
 namespace {
 
-const std::string kBlanket =
-    std::string("[case]\nname = \"flat_blanket\"\n") + kFlatBlanketBody + R"(
-[time]
-end_time = 2e-6
-[output]
-figures = false
-)";
+const std::string& kBlanket = kFlatBlanketBriefRun;
 
 const char* kTransfer = R"(
 [case]

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fem/io/result_reader.hpp"
+#include "impact/tow_damage_material.hpp"
 #include "render.hpp"
 #include "workflow/output/output_files.hpp"
 
@@ -233,6 +234,11 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
           render::MeshFigure fig;
           fig.field = p.at("field") == "none" ? "" : p.at("field").get<std::string>();
           fig.component = p.value("component", -1);
+          if (fig.field == "failed_mode") {  // impact/crush_measure.hpp: 0 none, 1 + FailureMode
+            fig.categories = {"none"};
+            for (const char* mode : impact::kModeNames) fig.categories.push_back(mode);
+            for (auto& c : fig.categories) std::replace(c.begin(), c.end(), '_', ' ');
+          }
           const std::string follow = p.value("follow_part", "");
           if (!follow.empty()) {
             int part = -1;

@@ -11,8 +11,7 @@
 // [0.06, 0.84] with its title above it; the figure title is centred at the top.
 #include "render.hpp"
 
-#include "egl_context.hpp"
-
+#include <unistd.h>
 #include <vtkActor.h>
 #include <vtkAxis.h>
 #include <vtkBrush.h>
@@ -30,6 +29,7 @@
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkImageData.h>
 #include <vtkLookupTable.h>
+#include <vtkMath.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPen.h>
@@ -47,9 +47,8 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
+#include <vtkVariant.h>
 #include <vtkWindowToImageFilter.h>
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -61,6 +60,8 @@
 #include <system_error>
 #include <unordered_map>
 
+#include "egl_context.hpp"
+
 // Defined in glew_shim.cpp. Referencing the marker makes the linker pull the shim's object file
 // out of the static library into every executable that renders.
 extern "C" const int ncfsim_render_glew_shim_marker;
@@ -70,8 +71,7 @@ namespace ncfsim::render {
 namespace {
 
 // One render at a time per process: GLEW's function pointers and the EGL display are global.
-std::mutex& render_mutex()
-{
+std::mutex& render_mutex() {
   static std::mutex m;
   return m;
 }
@@ -79,16 +79,14 @@ std::mutex& render_mutex()
 constexpr double kBackground[3] = {1.0, 1.0, 1.0};
 constexpr double kText[3] = {0.0, 0.0, 0.0};
 
-[[noreturn]] void fail(const std::string& where, const std::string& what)
-{
+[[noreturn]] void fail(const std::string& where, const std::string& what) {
   throw std::runtime_error(where + ": " + what);
 }
 
 // Collects VTK ErrorEvents of the objects it observes (instead of VTK printing them).
 class VtkErrors {
-public:
-  VtkErrors()
-  {
+ public:
+  VtkErrors() {
     callback_->SetClientData(this);
     callback_->SetCallback([](vtkObject* caller, unsigned long, void* client, void* call) {
       auto* self = static_cast<VtkErrors*>(client);
@@ -101,8 +99,7 @@ public:
     });
   }
   void watch(vtkObject* object) { object->AddObserver(vtkCommand::ErrorEvent, callback_); }
-  void throw_if_any(const std::string& where) const
-  {
+  void throw_if_any(const std::string& where) const {
     if (messages_.empty()) {
       return;
     }
@@ -113,13 +110,12 @@ public:
     fail(where, "VTK reported an error: " + all);
   }
 
-private:
+ private:
   vtkNew<vtkCallbackCommand> callback_;
   std::vector<std::string> messages_;
 };
 
-void check_shim(const std::string& where)
-{
+void check_shim(const std::string& where) {
   // Reading the marker keeps the reference alive under any optimisation level.
   if (ncfsim_render_glew_shim_marker != 1 || ncfsim_render_glew_shim_active() == 0) {
     fail(where,
@@ -129,8 +125,7 @@ void check_shim(const std::string& where)
   }
 }
 
-void check_size(const std::string& where, int width, int height)
-{
+void check_size(const std::string& where, int width, int height) {
   constexpr int kMax = 16384;
   if (width < 16 || height < 16 || width > kMax || height > kMax) {
     fail(where, "image size " + std::to_string(width) + "x" + std::to_string(height) +
@@ -138,8 +133,7 @@ void check_size(const std::string& where, int width, int height)
   }
 }
 
-std::filesystem::path temp_path_for(const std::filesystem::path& png)
-{
+std::filesystem::path temp_path_for(const std::filesystem::path& png) {
   static std::atomic<unsigned> counter{0};
   // Built by appending (GCC 12 gives a false -Wrestrict on "." + std::string).
   std::string name(".");
@@ -151,8 +145,7 @@ std::filesystem::path temp_path_for(const std::filesystem::path& png)
 
 // PNG-encodes the image in memory, writes it beside the destination, then renames it over it.
 void write_png_atomically(vtkImageData* image, const std::filesystem::path& png,
-                          const std::string& where)
-{
+                          const std::string& where) {
   if (png.filename().empty()) {
     fail(where, "output path '" + png.string() + "' names no file");
   }
@@ -201,23 +194,21 @@ void write_png_atomically(vtkImageData* image, const std::filesystem::path& png,
 // An EGL context plus a VTK window that renders into it. Renderers are added by the caller;
 // capture() renders and returns a copy of the RGB pixels.
 class OffscreenWindow {
-public:
+ public:
   OffscreenWindow(int width, int height, const std::string& where)
-      : where_(where), context_(width, height)
-  {
+      : where_(where), context_(width, height) {
     check_shim(where_);
     window_->SetSize(width, height);
-    window_->SetIsCurrent(true);        // EglContext made it current on this thread
+    window_->SetIsCurrent(true);  // EglContext made it current on this thread
     window_->SetReadyForRendering(true);
     window_->SetSupportsOpenGL(1);
     window_->SetIsDirect(1);
     window_->SetMapped(1);
-    window_->SetMultiSamples(4);        // MSAA on llvmpipe: smooth edges, deterministic
+    window_->SetMultiSamples(4);  // MSAA on llvmpipe: smooth edges, deterministic
     window_->SetAlphaBitPlanes(0);
     errors_.watch(window_);
   }
-  ~OffscreenWindow()
-  {
+  ~OffscreenWindow() {
     // Release VTK's GL objects while the context is still current (context_ dies after this).
     window_->Finalize();
   }
@@ -227,8 +218,7 @@ public:
   vtkGenericOpenGLRenderWindow* window() { return window_; }
   VtkErrors& errors() { return errors_; }
 
-  vtkSmartPointer<vtkImageData> capture()
-  {
+  vtkSmartPointer<vtkImageData> capture() {
     window_->Render();
     errors_.throw_if_any(where_);
     vtkNew<vtkWindowToImageFilter> grab;
@@ -246,25 +236,25 @@ public:
     const int* size = window_->GetSize();
     if (dims[0] != size[0] || dims[1] != size[1]) {
       fail(where_, "read back a " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) +
-                       " image from a " + std::to_string(size[0]) + "x" +
-                       std::to_string(size[1]) + " window");
+                       " image from a " + std::to_string(size[0]) + "x" + std::to_string(size[1]) +
+                       " window");
     }
     return image;
   }
 
-private:
+ private:
   std::string where_;
-  detail::EglContext context_; // declared before the VTK objects: destroyed after them
+  detail::EglContext context_;  // declared before the VTK objects: destroyed after them
   VtkErrors errors_;
   vtkNew<vtkGenericOpenGLRenderWindow> window_;
 };
 
 // VTK's built-in "Arial" on Debian draws '[' and ']' as round brackets, which garbles units; use
 // DejaVu Sans (fonts-dejavu-core, a dependency of fontconfig and so of VTK) when it is installed.
-const char* dejavu_sans(bool bold)
-{
-  static const bool have = std::filesystem::exists("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf") &&
-                           std::filesystem::exists("/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf");
+const char* dejavu_sans(bool bold) {
+  static const bool have =
+      std::filesystem::exists("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf") &&
+      std::filesystem::exists("/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf");
   if (!have) {
     return nullptr;
   }
@@ -272,8 +262,7 @@ const char* dejavu_sans(bool bold)
               : "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 }
 
-void style_text(vtkTextProperty* p, int font_size, bool bold)
-{
+void style_text(vtkTextProperty* p, int font_size, bool bold) {
   if (const char* file = dejavu_sans(bold); file != nullptr) {
     p->SetFontFamily(VTK_FONT_FILE);
     p->SetFontFile(file);
@@ -288,8 +277,7 @@ void style_text(vtkTextProperty* p, int font_size, bool bold)
   p->SetOpacity(1.0);
 }
 
-int scaled_font(int height, double fraction, int minimum)
-{
+int scaled_font(int height, double fraction, int minimum) {
   return std::max(minimum, static_cast<int>(std::lround(fraction * height)));
 }
 
@@ -297,13 +285,12 @@ int scaled_font(int height, double fraction, int minimum)
 // Mesh figures
 
 struct Scalars {
-  std::vector<double> values; // one per point (on_cells = false) or per cell, hexes then bars
+  std::vector<double> values;  // one per point (on_cells = false) or per cell, hexes then bars
   bool on_cells = false;
-  std::string bar_title;      // "name [unit]", "name (x) [unit]", "name (magnitude) [unit]"
+  std::string bar_title;  // "name [unit]", "name (x) [unit]", "name (magnitude) [unit]"
 };
 
-void validate_mesh(const RenderMesh& mesh, const std::string& where)
-{
+void validate_mesh(const RenderMesh& mesh, const std::string& where) {
   if (mesh.points.empty() || mesh.points.size() % 3 != 0) {
     fail(where, "points must hold 3 coordinates per node and at least one node, got " +
                     std::to_string(mesh.points.size()) + " values");
@@ -313,8 +300,8 @@ void validate_mesh(const RenderMesh& mesh, const std::string& where)
                     std::to_string(mesh.hex8.size()) + " ids");
   }
   if (mesh.bar2.size() % 2 != 0) {
-    fail(where, "bar2 must hold 2 node ids per bar, got " + std::to_string(mesh.bar2.size()) +
-                    " ids");
+    fail(where,
+         "bar2 must hold 2 node ids per bar, got " + std::to_string(mesh.bar2.size()) + " ids");
   }
   if (mesh.hex8.empty() && mesh.bar2.empty()) {
     fail(where, "the mesh has no hexahedra and no bars");
@@ -324,8 +311,7 @@ void validate_mesh(const RenderMesh& mesh, const std::string& where)
     for (std::size_t i = 0; i < ids.size(); ++i) {
       if (ids[i] < 0 || ids[i] >= n_points) {
         fail(where, std::string(what) + " entry " + std::to_string(i) + " is node id " +
-                        std::to_string(ids[i]) + ", outside [0, " + std::to_string(n_points) +
-                        ")");
+                        std::to_string(ids[i]) + ", outside [0, " + std::to_string(n_points) + ")");
       }
     }
   };
@@ -338,16 +324,14 @@ void validate_mesh(const RenderMesh& mesh, const std::string& where)
   }
 }
 
-std::string component_name(int component, int n_components)
-{
+std::string component_name(int component, int n_components) {
   if (n_components <= 3) {
     return std::string(1, "xyz"[component]);
   }
   return std::to_string(component);
 }
 
-Scalars select_scalars(const RenderMesh& mesh, const MeshFigure& figure, const std::string& where)
-{
+Scalars select_scalars(const RenderMesh& mesh, const MeshFigure& figure, const std::string& where) {
   const MeshField* field = nullptr;
   for (const auto& f : mesh.fields) {
     if (f.name == figure.field) {
@@ -360,8 +344,8 @@ Scalars select_scalars(const RenderMesh& mesh, const MeshFigure& figure, const s
     for (const auto& f : mesh.fields) {
       names += (names.empty() ? "" : ", ") + f.name;
     }
-    fail(where, "unknown field '" + figure.field + "' (the mesh has: " +
-                    (names.empty() ? std::string("no fields") : names) + ")");
+    fail(where, "unknown field '" + figure.field +
+                    "' (the mesh has: " + (names.empty() ? std::string("no fields") : names) + ")");
   }
   const int n_comp = field->n_components;
   if (n_comp < 1) {
@@ -409,8 +393,7 @@ Scalars select_scalars(const RenderMesh& mesh, const MeshFigure& figure, const s
 }
 
 std::array<double, 2> colour_range(const Scalars& s, const MeshFigure& figure,
-                                   const std::string& where)
-{
+                                   const std::string& where) {
   double lo = 0.0, hi = 0.0;
   if (figure.range) {
     lo = (*figure.range)[0];
@@ -428,12 +411,12 @@ std::array<double, 2> colour_range(const Scalars& s, const MeshFigure& figure,
         hi = std::max(hi, v);
       }
     }
-    if (lo > hi) { // no finite value at all
+    if (lo > hi) {  // no finite value at all
       lo = 0.0;
       hi = 1.0;
     }
   }
-  if (hi <= lo) { // a uniform field: centre it in a small range so it maps to the middle colour
+  if (hi <= lo) {  // a uniform field: centre it in a small range so it maps to the middle colour
     const double pad = lo != 0.0 ? 0.01 * std::abs(lo) : 1.0;
     lo -= pad;
     hi += pad;
@@ -442,8 +425,7 @@ std::array<double, 2> colour_range(const Scalars& s, const MeshFigure& figure,
 }
 
 // Blue (low) to red (high) through cyan, green, yellow: the usual FE contour map.
-vtkSmartPointer<vtkLookupTable> make_lookup_table(const std::array<double, 2>& range)
-{
+vtkSmartPointer<vtkLookupTable> make_lookup_table(const std::array<double, 2>& range) {
   auto lut = vtkSmartPointer<vtkLookupTable>::New();
   lut->SetNumberOfTableValues(256);
   lut->SetHueRange(0.6667, 0.0);
@@ -456,8 +438,7 @@ vtkSmartPointer<vtkLookupTable> make_lookup_table(const std::array<double, 2>& r
 }
 
 vtkSmartPointer<vtkDoubleArray> make_array(const std::string& name, const double* values,
-                                           std::size_t n)
-{
+                                           std::size_t n) {
   auto a = vtkSmartPointer<vtkDoubleArray>::New();
   a->SetName(name.c_str());
   a->SetNumberOfComponents(1);
@@ -467,34 +448,33 @@ vtkSmartPointer<vtkDoubleArray> make_array(const std::string& name, const double
 }
 
 void apply_camera(vtkRenderer* renderer, CameraPreset preset,
-                  const std::optional<std::array<double, 6>>& focus)
-{
+                  const std::optional<std::array<double, 6>>& focus) {
   vtkCamera* camera = renderer->GetActiveCamera();
   camera->SetFocalPoint(0.0, 0.0, 0.0);
   switch (preset) {
-  case CameraPreset::Top:
-    camera->SetPosition(0.0, 0.0, 1.0);
-    camera->SetViewUp(0.0, 1.0, 0.0);
-    break;
-  case CameraPreset::Front:
-    camera->SetPosition(0.0, -1.0, 0.0);
-    camera->SetViewUp(0.0, 0.0, 1.0);
-    break;
-  case CameraPreset::Iso:
-    // Not the exact (1, -1, 1) diagonal: under the headlight its three visible faces of a box
-    // would get the same brightness and merge into one flat shape.
-    // Looking down at about 44 degrees so that top faces (sheets, drapes) are the brightest.
-    camera->SetPosition(1.0, -1.2, 1.5);
-    camera->SetViewUp(0.0, 0.0, 1.0);
-    break;
+    case CameraPreset::Top:
+      camera->SetPosition(0.0, 0.0, 1.0);
+      camera->SetViewUp(0.0, 1.0, 0.0);
+      break;
+    case CameraPreset::Front:
+      camera->SetPosition(0.0, -1.0, 0.0);
+      camera->SetViewUp(0.0, 0.0, 1.0);
+      break;
+    case CameraPreset::Iso:
+      // Not the exact (1, -1, 1) diagonal: under the headlight its three visible faces of a box
+      // would get the same brightness and merge into one flat shape.
+      // Looking down at about 44 degrees so that top faces (sheets, drapes) are the brightest.
+      camera->SetPosition(1.0, -1.2, 1.5);
+      camera->SetViewUp(0.0, 0.0, 1.0);
+      break;
   }
   camera->ParallelProjectionOn();
   if (focus) {
     double b[6];
     std::copy(focus->begin(), focus->end(), b);
-    renderer->ResetCamera(b); // fits the focus box (a followed part), keeps the direction
+    renderer->ResetCamera(b);  // fits the focus box (a followed part), keeps the direction
   } else {
-    renderer->ResetCamera(); // keeps the direction, fits the bounds
+    renderer->ResetCamera();  // keeps the direction, fits the bounds
   }
   renderer->ResetCameraClippingRange();
 }
@@ -504,12 +484,11 @@ void apply_camera(vtkRenderer* renderer, CameraPreset preset,
 // with vtkDataSetSurfaceFilter / vtkGeometryFilter, whose VTK 9.1 versions leak an allocation
 // per call (vtkGeometryFilterHelper::CharacterizeUnstructuredGrid), which fails ASan builds.
 struct BoundaryQuads {
-  std::vector<vtkIdType> nodes; // [4 * n_faces]
-  std::vector<std::size_t> hex; // [n_faces]
+  std::vector<vtkIdType> nodes;  // [4 * n_faces]
+  std::vector<std::size_t> hex;  // [n_faces]
 };
 
-BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8)
-{
+BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8) {
   static constexpr int kFaces[6][4] = {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4},
                                        {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}};
   struct Key {
@@ -517,8 +496,7 @@ BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8)
     bool operator==(const Key& o) const { return sorted == o.sorted; }
   };
   struct KeyHash {
-    std::size_t operator()(const Key& k) const
-    {
+    std::size_t operator()(const Key& k) const {
       std::uint64_t h = 1469598103934665603ULL;
       for (std::int64_t v : k.sorted) {
         h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ULL;
@@ -547,7 +525,7 @@ BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8)
       boundary.push_back(value.first);
     }
   }
-  std::sort(boundary.begin(), boundary.end()); // deterministic order, independent of hashing
+  std::sort(boundary.begin(), boundary.end());  // deterministic order, independent of hashing
   BoundaryQuads out;
   out.nodes.reserve(4 * boundary.size());
   out.hex.reserve(boundary.size());
@@ -562,7 +540,7 @@ BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8)
   return out;
 }
 
-} // namespace
+}  // namespace
 
 RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop) {
   const std::size_t n_hex = mesh.hex8.size() / 8;
@@ -593,8 +571,7 @@ RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop) 
 }
 
 void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
-                     const std::filesystem::path& png)
-{
+                     const std::filesystem::path& png) {
   const std::string where = "render_mesh_png('" + png.string() + "')";
   check_size(where, figure.width, figure.height);
   validate_mesh(mesh, where);
@@ -604,6 +581,8 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
   if (coloured) {
     scalars = select_scalars(mesh, figure, where);
     range = colour_range(scalars, figure, where);
+    if (!figure.categories.empty())
+      range = {0.0, static_cast<double>(figure.categories.size() - 1)};
   }
 
   std::lock_guard lock(render_mutex());
@@ -620,6 +599,28 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
     points->SetPoint(static_cast<vtkIdType>(i), mesh.points.data() + 3 * i);
   }
   vtkSmartPointer<vtkLookupTable> lut = make_lookup_table(range);
+  if (!figure.categories.empty()) {
+    // One colour per category (the first, "none", light grey), named on the bar.
+    const auto n = static_cast<vtkIdType>(figure.categories.size());
+    lut = vtkSmartPointer<vtkLookupTable>::New();
+    lut->SetNumberOfTableValues(n);
+    lut->SetTableRange(range[0], range[1]);
+    lut->Build();
+    for (vtkIdType k = 0; k < n; ++k) {
+      if (k == 0) {
+        lut->SetTableValue(0, 0.85, 0.85, 0.85, 1.0);
+      } else {
+        double rgb[3];
+        const double h =
+            n > 2 ? 0.6667 * (1.0 - static_cast<double>(k - 1) / static_cast<double>(n - 2)) : 0.0;
+        vtkMath::HSVToRGB(h, 1.0, 1.0, rgb, rgb + 1, rgb + 2);
+        lut->SetTableValue(k, rgb[0], rgb[1], rgb[2], 1.0);
+      }
+      lut->SetAnnotation(vtkVariant(static_cast<double>(k)),
+                         figure.categories[static_cast<std::size_t>(k)]);
+    }
+    lut->IndexedLookupOn();
+  }
   vtkSmartPointer<vtkDoubleArray> point_scalars;
   if (coloured && !scalars.on_cells) {
     point_scalars = make_array(figure.field, scalars.values.data(), n_points);
@@ -638,17 +639,17 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
       mapper->SetScalarModeToUseCellData();
     } else {
       mapper->SetScalarModeToUsePointData();
-      mapper->InterpolateScalarsBeforeMappingOn(); // colour bands follow the map, not RGB blends
+      mapper->InterpolateScalarsBeforeMappingOn();  // colour bands follow the map, not RGB blends
     }
   };
 
   vtkNew<vtkRenderer> scene;
   scene->SetViewport(0.0, 0.0, 0.82, 0.92);
-  scene->SetLayer(1); // drawn over the annotation layer's background, no clear of its own
+  scene->SetLayer(1);  // drawn over the annotation layer's background, no clear of its own
   scene->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
   scene->UseFXAAOff();
 
-  vtkNew<vtkPolyData> solid; // boundary quads of the hexahedra
+  vtkNew<vtkPolyData> solid;  // boundary quads of the hexahedra
   vtkNew<vtkPolyDataMapper> solid_mapper;
   vtkNew<vtkActor> solid_actor;
   if (n_hex > 0) {
@@ -754,14 +755,20 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
     // pad the labels with trailing spaces (they count in the text width).
     bar->SetLabelFormat("%#.4g  ");
     bar->SetTextPad(1);
-    bar->SetTextPositionToPrecedeScalarBar(); // labels left of the colour strip
-    bar->UnconstrainedFontSizeOn();           // keep the font sizes set below
+    bar->SetTextPositionToPrecedeScalarBar();  // labels left of the colour strip
+    bar->UnconstrainedFontSizeOn();            // keep the font sizes set below
     style_text(bar->GetLabelTextProperty(), scaled_font(figure.height, 0.019, 9), false);
     bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
     bar->GetPositionCoordinate()->SetValue(0.85, 0.06);
     bar->GetPosition2Coordinate()->SetCoordinateSystemToNormalizedViewport();
-    bar->GetPosition2Coordinate()->SetValue(0.135, 0.78); // width, height (relative to Position)
+    bar->GetPosition2Coordinate()->SetValue(0.135, 0.78);  // width, height (relative to Position)
     bar->SetBarRatio(0.32);
+    if (!figure.categories.empty()) {
+      bar->DrawAnnotationsOn();
+      bar->SetNumberOfLabels(0);
+      bar->SetTextPositionToSucceedScalarBar();  // the names left of the strip, inside the image
+      style_text(bar->GetAnnotationTextProperty(), scaled_font(figure.height, 0.019, 9), false);
+    }
     annotation->AddActor2D(bar);
 
     const int title_font = scaled_font(figure.height, 0.022, 10);
@@ -769,7 +776,8 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
     // Two lines ("name" / "[unit]") when one would be much wider than the bar's column.
     const double column_px = 0.2 * figure.width;
     const auto unit_at = text.rfind(" [");
-    if (unit_at != std::string::npos && 0.62 * title_font * static_cast<double>(text.size()) > column_px) {
+    if (unit_at != std::string::npos &&
+        0.62 * title_font * static_cast<double>(text.size()) > column_px) {
       text[unit_at] = '\n';
     }
     bar_title->SetInput(text.c_str());
@@ -799,13 +807,12 @@ namespace {
 
 // matplotlib's tab10: distinct, colour-blind-friendlier than pure RGB.
 constexpr unsigned char kPalette[10][3] = {
-    {31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},   {148, 103, 189},
+    {31, 119, 180}, {255, 127, 14},  {44, 160, 44},   {214, 39, 40},  {148, 103, 189},
     {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
 
-} // namespace
+}  // namespace
 
-void plot_curves_png(const CurvePlot& plot, const std::filesystem::path& png)
-{
+void plot_curves_png(const CurvePlot& plot, const std::filesystem::path& png) {
   const std::string where = "plot_curves_png('" + png.string() + "')";
   check_size(where, plot.width, plot.height);
   if (plot.series.empty()) {
@@ -838,7 +845,7 @@ void plot_curves_png(const CurvePlot& plot, const std::filesystem::path& png)
   chart->SetTitle(plot.title);
   style_text(chart->GetTitleProperties(), scaled_font(h, 0.032, 12), true);
   chart->SetShowLegend(true);
-  chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::LEFT); // curves mostly rise
+  chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::LEFT);  // curves mostly rise
   chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
   style_text(chart->GetLegend()->GetLabelProperties(), scaled_font(h, 0.022, 9), false);
   chart->GetLegend()->GetBrush()->SetColor(255, 255, 255, 230);
@@ -890,8 +897,7 @@ void plot_curves_png(const CurvePlot& plot, const std::filesystem::path& png)
 
 // ----------------------------------------------------------------------------------------------
 
-bool offscreen_rendering_available(std::string* why)
-{
+bool offscreen_rendering_available(std::string* why) {
   try {
     std::lock_guard lock(render_mutex());
     detail::EglContext context(16, 16);
@@ -910,4 +916,4 @@ bool offscreen_rendering_available(std::string* why)
   }
 }
 
-} // namespace ncfsim::render
+}  // namespace ncfsim::render

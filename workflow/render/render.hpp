@@ -30,10 +30,10 @@ struct MeshField {
 };
 
 struct RenderMesh {
-  std::vector<double> points;       // xyz interleaved, [3*n_points]
-  std::vector<std::int64_t> hex8;   // 8 node ids per hexahedron (VTK ordering)
-  std::vector<std::int64_t> bar2;   // 2 node ids per bar
-  std::vector<MeshField> fields;    // cell fields have values for hexes first, then bars
+  std::vector<double> points;      // xyz interleaved, [3*n_points]
+  std::vector<std::int64_t> hex8;  // 8 node ids per hexahedron (VTK ordering)
+  std::vector<std::int64_t> bar2;  // 2 node ids per bar
+  std::vector<MeshField> fields;   // cell fields have values for hexes first, then bars
 };
 
 // Top: looking down -z, +y up. Front: looking along +y, +z up. Iso: from the (+x, -y, +z) octant,
@@ -42,15 +42,18 @@ struct RenderMesh {
 enum class CameraPreset { Top, Iso, Front };
 
 struct MeshFigure {
-  std::string field;     // name of a RenderMesh field; empty = plain grey geometry, no scalar bar
-  int component = -1;    // -1 = magnitude (the value itself for a 1-component field)
-  std::string title;     // drawn at the top centre; empty = no title
+  std::string field;   // name of a RenderMesh field; empty = plain grey geometry, no scalar bar
+  int component = -1;  // -1 = magnitude (the value itself for a 1-component field)
+  std::string title;   // drawn at the top centre; empty = no title
   CameraPreset camera = CameraPreset::Iso;
   int width = 1200, height = 900;
-  std::optional<std::array<double, 2>> range; // colour range; default = data range (finite values)
+  std::optional<std::array<double, 2>> range;  // colour range; default = data range (finite values)
   // Box the camera fits (xmin xmax ymin ymax zmin zmax), e.g. the current bounds of a part the view
   // follows; default = the whole mesh.
   std::optional<std::array<double, 6>> focus_bounds;
+  // A categorical field (integer values 0 .. n-1): one colour per value, the scalar bar names
+  // them (e.g. the failed mode of a crush). Empty: a continuous field.
+  std::vector<std::string> categories;
 };
 
 // The mesh without the hexahedra marked in `drop` (one flag per hexahedron, e.g. eroded ones, whose
@@ -86,4 +89,4 @@ void plot_curves_png(const CurvePlot& plot, const std::filesystem::path& png);
 // when why is given, the reason. Never throws.
 bool offscreen_rendering_available(std::string* why = nullptr);
 
-} // namespace ncfsim::render
+}  // namespace ncfsim::render
