@@ -62,8 +62,13 @@ void TowDamageMaterial::update_stress(const fem::MaterialBatch& b) const {
     fem::accumulate_strain_orthotropic_stress(C, de, t, h, s, e, E, S);
     const double L1 = len ? len[e] : L0, L2 = len ? len[s + e] : L0, L3 = len ? len[2 * s + e] : L0;
     // Failure indices and the length across each mode's crack.
+    // Fibre compression: kinking (Argon, the linearised LaRC03 criterion with sigma_22 = 0): the
+    // fibres misaligned by phi0 = S12 / Xc kink when the shear in their frame, |s11| phi0 + |tau|,
+    // reaches S12; pure compression fails at Xc, axial shear brings it on earlier.
+    const double tau = std::sqrt(S[3] * S[3] + S[5] * S[5]);
+    const double kink = S[0] < 0 ? -S[0] / strength_[1] + tau / strength_[4] : 0.0;
     const double f[kModes] = {std::max(S[0], 0.0) / strength_[0],
-                              std::max(-S[0], 0.0) / strength_[1],
+                              kink,
                               std::max({S[1], S[2], 0.0}) / strength_[2],
                               std::max({-S[1], -S[2], 0.0}) / strength_[3],
                               std::sqrt(S[3] * S[3] + S[5] * S[5]) / strength_[4],

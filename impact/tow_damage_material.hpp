@@ -3,7 +3,10 @@
 // Voigt 11 22 33 12 23 13, engineering shears). Orthotropic elastic (the transfer's constants),
 // then per failure mode m:
 //   initiation on the effective stress s = C0 E (maximum stress, modes kept apart):
-//     fibre_tension       f = <s11>+ / Xt           fibre_compression  f = <s11>- / Xc
+//     fibre_tension       f = <s11>+ / Xt
+//     fibre_compression   f = <s11>- / Xc + sqrt(s12^2 + s13^2) / S12 where s11 < 0 (kinking:
+//                         fibres misaligned by S12 / Xc fail when the shear in their frame
+//                         reaches S12; the linearised LaRC03 criterion; pure compression: Xc)
 //     matrix_tension      f = max(<s22>+, <s33>+) / Yt
 //     matrix_compression  f = max(<s22>-, <s33>-) / Yc
 //     in_plane_shear      f = sqrt(s12^2 + s13^2) / S12      transverse_shear  f = |s23| / S23

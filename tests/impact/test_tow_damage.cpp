@@ -155,6 +155,32 @@ TEST(TowDamage, DamageIsIrreversibleAndUnloadsThroughTheOrigin) {
   EXPECT_EQ(p.h[12 + 3], 0.0);
 }
 
+// Kinking: under axial shear at half its strength, the fibres kink at half the compressive
+// strength (|s11| / Xc + |tau| / S12 = 1), where the maximum-stress index alone waited for Xc and
+// the shear never failed; in tension the same shear does not count.
+TEST(TowDamage, AxialShearBringsFibreKinkingOn) {
+  const auto c = t700_epoxy();
+  const impact::TowDamageMaterial mat("tow", c);
+  for (double sign : {-1.0, 1.0}) {
+    Point p{mat, 1e-4};
+    double E[6] = {0, 0, 0, 0.5 * c.strength.S12 / c.elastic.G12, 0, 0};
+    p.go_to(E);
+    double s11_at_onset = 0;
+    const int steps = 2000;
+    for (int i = 1; i <= steps && s11_at_onset == 0; ++i) {
+      E[0] = sign * 1.2 * c.strength.Xc / c.elastic.E1 * i / steps;
+      p.go_to(E);
+      if (p.h[12 + 1] > 0 || p.h[12 + 0] > 0) s11_at_onset = p.S[0];
+    }
+    if (sign < 0) {
+      EXPECT_TRUE(test::near_rel(-s11_at_onset, 0.5 * c.strength.Xc, 0.01)) << s11_at_onset;
+      EXPECT_EQ(p.h[12 + 4], 0.0) << "the shear itself did not fail";
+    } else {
+      EXPECT_EQ(s11_at_onset, 0.0) << "no fibre damage below Xt in tension";
+    }
+  }
+}
+
 TEST(TowDamage, SnapBackLengthAndBadConstantsAreReported) {
   auto c = t700_epoxy();
   const impact::TowDamageMaterial mat("tow", c);
