@@ -169,7 +169,7 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   EXPECT_LT(cs["peak_force_N"].get<double>(), 5000.0);
   EXPECT_GT(cs["energy_absorbed_J"].get<double>(), 0.0);
   EXPECT_GT(cs["stroke_at_peak_m"].get<double>(), 0.0);
-  // The goal is 5 %; this session's run closed at 7.1 % (docs/fabric-data.md, "Crush").
+  // The goal is 5 %; this session's run closed at 4.4 % (docs/fabric-data.md, "Crush").
   EXPECT_LT(cs["energy_balance_error"].get<double>(), 0.10);
   EXPECT_LT(cs["punch_max_penetration_m"].get<double>(), 0.1 * 0.23e-3) << "the punch sinks in";
   double failed = 0;
@@ -187,7 +187,7 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   }
 
   // Ten times the punch speed over the same stroke: the kinetic share is warned about (this
-  // session: 0.65 against 0.24 at 1.5 m/s, limit 0.35), not passed silently.
+  // session: 0.45 against 0.14 at 1.5 m/s, limit 0.3), not passed silently.
   const fs::path fast = out / "crush_fast";
   const auto fast_run =
       run_cli(with({"-o", fast.string(), "--set", "tool[0].velocity=[0.0,0.0,-15.0]", "--set",
