@@ -25,7 +25,6 @@ struct CohesiveLaw {
 struct CohesiveState {
   double max_separation = 0;  // largest mixed-mode separation reached, m
   double damage = 0;          // [0, 1]; 1: separated
-  double dissipated = 0;      // energy per area dissipated so far, J/m^2
 };
 
 /// Tractions (normal tn, shear ts along the sliding direction) at separations dn (opening > 0)
@@ -48,10 +47,6 @@ inline void cohesive_tractions(const CohesiveLaw& law, double dn, double ds, Coh
     if (dm > dm0) {
       const double d = dmf * (dm - dm0) / (dm * std::max(dmf - dm0, 1e-300));
       st.damage = std::clamp(std::max(st.damage, d), 0.0, 1.0);
-      // Dissipated per area at this state: the work along the envelope less the energy the
-      // unloading line to the origin still holds, 1/2 K dm0 d dm_max (G_c at full damage).
-      st.dissipated =
-          std::max(st.dissipated, 0.5 * law.K * dm0 * std::min(st.damage * st.max_separation, dmf));
     }
   }
   const double keep = 1 - st.damage;

@@ -181,15 +181,7 @@ void TiedContact::initialise(const ContactSetup& setup) {
     if (node_.empty())
       throw InputError(cfg_.source_file, prefix + ".face_pairs",
                        "no slave node lies within the search distance of its paired master faces");
-    alive_.assign(node_.size(), 1);
-    state_.assign(node_.size(), CohesiveState{});
-    tie_work_.assign(node_.size(), 0.0);
-    failed_work_ = 0;
-    last_sep_.assign(3 * node_.size(), 0.0);
-    last_force_.assign(3 * node_.size(), 0.0);
-    n_alive_ = static_cast<std::int64_t>(node_.size());
-    dissipation_ = 0;
-    force_ = {};
+    reset_tie_state();
     return;
   }
   ContactGroup slave = cfg_.slave, master = cfg_.master;
@@ -252,6 +244,10 @@ void TiedContact::initialise(const ContactSetup& setup) {
   if (node_.empty())
     throw InputError(cfg_.source_file, prefix + ".search_distance",
                      "no slave node lies within " + std::to_string(r) + " m of the master surface");
+  reset_tie_state();
+}
+
+void TiedContact::reset_tie_state() {
   alive_.assign(node_.size(), 1);
   state_.assign(node_.size(), CohesiveState{});
   tie_work_.assign(node_.size(), 0.0);
@@ -304,8 +300,7 @@ void TiedContact::add_forces(const double* x, const double*, const double*, doub
     const double dn = d[0] * tf.n[0] + d[1] * tf.n[1] + d[2] * tf.n[2];
     const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     if (cohesive_) {
-      // Tractions from the bilinear law at this node's separations (K = k / area); the energy
-      // the damage increment releases, 1/2 dd K dm^2 per area, is dissipated.
+      // Tractions from the bilinear law at this node's separations (K = k / area).
       const double A = area_[t];
       const CohesiveLaw law{k / A,
                             cfg_.normal_strength,

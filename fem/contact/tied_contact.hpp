@@ -44,6 +44,8 @@ class TiedContact final : public ContactAlgorithm {
   double search_distance() const { return search_distance_; }
 
  private:
+  /// Every tie intact, no work done yet (after the ties are found).
+  void reset_tie_state();
   /// Ties each node of the configured slave faces to the nearest of its paired master faces.
   void initialise_face_pairs(const ContactSetup& setup);
   void add_tie(std::int32_t node, const std::int32_t* corners, double xi, double eta,
@@ -69,8 +71,8 @@ class TiedContact final : public ContactAlgorithm {
   // Cohesive ties: the work done on each tie (trapezoidal in its separation) and the separation
   // and force of the last cycle; what a tie dissipated is its work less the energy it holds.
   std::vector<double> tie_work_, last_sep_, last_force_;
-  double failed_work_ = 0;  // work done on the ties that have failed (all dissipated)
-  std::vector<std::uint8_t> alive_;      // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
+  double failed_work_ = 0;           // work done on the ties that have failed (all dissipated)
+  std::vector<std::uint8_t> alive_;  // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
   std::int64_t n_alive_ = 0;
   double dissipation_ = 0;
   V3 force_;  // on the slave group, N
