@@ -7,10 +7,11 @@ namespace ncfsim::fem {
 
 double EnergyBalance::error() const {
   const double residual = total() - initial_total - external_work;
-  const double scale = std::max({std::abs(initial_total) + std::abs(external_work),
-                                 std::abs(kinetic) + std::abs(internal) + std::abs(hourglass) +
-                                     std::abs(contact) + std::abs(damping),
-                                 1e-30});
+  const double scale =
+      std::max({std::abs(initial_total) + std::abs(external_work),
+                std::abs(kinetic) + std::abs(internal) + std::abs(hourglass) + std::abs(contact) +
+                    std::abs(damping) + std::abs(eroded_kinetic),
+                1e-30});
   return std::abs(residual) / scale;
 }
 

@@ -18,18 +18,22 @@ struct WorkAccumulator {
 struct EnergyBalance {
   double time = 0;
   double kinetic = 0;
-  double internal = 0;       // stress work of all elements, incl. physical stabilisation
-  double stabilisation = 0;  // part of internal carried by the hex stabilisation
-  double hourglass = 0;      // viscous (non-physical) hourglass work
-  double contact = 0;        // interface energy: penalty stored + friction dissipated
-  double friction = 0;       // part of contact dissipated by friction
-  double damping = 0;        // dissipated by mass damping
-  double external_work = 0;  // applied loads, gravity, supports, tools
-  double initial_total = 0;  // kinetic + internal at t = 0
+  double internal = 0;         // stress work of all elements, incl. physical stabilisation
+  double stabilisation = 0;    // part of internal carried by the hex stabilisation
+  double hourglass = 0;        // viscous (non-physical) hourglass work
+  double contact = 0;          // interface energy: penalty stored + friction dissipated
+  double friction = 0;         // part of contact dissipated by friction
+  double damping = 0;          // dissipated by mass damping
+  double external_work = 0;    // applied loads, gravity, supports, tools
+  double initial_total = 0;    // kinetic + internal at t = 0
   double eroded_internal = 0;  // elastic energy held by eroded elements when they went (part of
                                // internal: it stays counted there, it is no longer recoverable)
+  double eroded_kinetic = 0;   // kinetic energy of nodes left with no element by erosion when
+                               // they were taken out of the model (they stop and leave contact)
 
-  double total() const { return kinetic + internal + hourglass + contact + damping; }
+  double total() const {
+    return kinetic + internal + hourglass + contact + damping + eroded_kinetic;
+  }
   /// |E - E0 - W_ext| over the largest energy in play.
   double error() const;
 };

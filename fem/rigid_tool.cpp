@@ -1,15 +1,15 @@
 #include "fem/rigid_tool.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <stdexcept>
-
 #include <vtkCellArray.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
 #include <vtkSTLReader.h>
 #include <vtkTriangleFilter.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
 
 namespace ncfsim::fem {
 
@@ -39,7 +39,8 @@ V3 closest_on_triangle(const V3& p, const V3& a, const V3& b, const V3& c) {
 
 }  // namespace
 
-TriangleSurface::TriangleSurface(std::vector<std::array<V3, 3>> triangles) : tri_(std::move(triangles)) {
+TriangleSurface::TriangleSurface(std::vector<std::array<V3, 3>> triangles)
+    : tri_(std::move(triangles)) {
   if (tri_.empty()) throw std::invalid_argument("triangulated surface has no triangles");
   const double big = std::numeric_limits<double>::max();
   lo_ = {big, big, big};
@@ -77,7 +78,8 @@ TriangleSurface::TriangleSurface(std::vector<std::array<V3, 3>> triangles) : tri
               static_cast<std::int32_t>(t));
   }
   start_.assign(n_cells + 1, 0);
-  for (std::size_t c = 0; c < n_cells; ++c) start_[c + 1] = start_[c] + static_cast<std::int32_t>(bins[c].size());
+  for (std::size_t c = 0; c < n_cells; ++c)
+    start_[c + 1] = start_[c] + static_cast<std::int32_t>(bins[c].size());
   items_.reserve(static_cast<std::size_t>(start_.back()));
   for (auto& b : bins) items_.insert(items_.end(), b.begin(), b.end());
 }
@@ -123,7 +125,8 @@ bool TriangleSurface::closest(const V3& p, double radius, double& gap, V3& norma
   V3 best_q;
   for (int k = idx(p.z - radius, lo_.z, dims_[2]); k <= idx(p.z + radius, lo_.z, dims_[2]); ++k)
     for (int j = idx(p.y - radius, lo_.y, dims_[1]); j <= idx(p.y + radius, lo_.y, dims_[1]); ++j)
-      for (int i = idx(p.x - radius, lo_.x, dims_[0]); i <= idx(p.x + radius, lo_.x, dims_[0]); ++i) {
+      for (int i = idx(p.x - radius, lo_.x, dims_[0]); i <= idx(p.x + radius, lo_.x, dims_[0]);
+           ++i) {
         const std::size_t c = static_cast<std::size_t>(i + dims_[0] * (j + dims_[1] * k));
         for (std::int32_t s = start_[c]; s < start_[c + 1]; ++s) {
           const auto t = static_cast<std::size_t>(items_[static_cast<std::size_t>(s)]);
@@ -292,9 +295,11 @@ void tool_contact_forces(RigidTool& tool, const double* x, const double* v, cons
   std::int64_t active = 0;
   if (near.valid) {
     for (const auto s : near.near)
-      active += tool_node_force(tool, static_cast<std::size_t>(s), x, v, mass, dt, inv_dt2, fc, ftool);
+      active +=
+          tool_node_force(tool, static_cast<std::size_t>(s), x, v, mass, dt, inv_dt2, fc, ftool);
   } else {  // rebuild: every contact node, and the near list for the cycles that follow
-    if (near.margin <= 0) near.margin = tool.search_margin > 0 ? tool.search_margin : automatic_margin(tool, x);
+    if (near.margin <= 0)
+      near.margin = tool.search_margin > 0 ? tool.search_margin : automatic_margin(tool, x);
     near.near.clear();
     near.x_ref.resize(3 * n);
     for (std::size_t s = 0; s < n; ++s) {
@@ -311,6 +316,24 @@ void tool_contact_forces(RigidTool& tool, const double* x, const double* v, cons
   }
   tool.force = ftool;
   tool.n_active = active;
+}
+
+void remove_tool_contact_nodes(RigidTool& tool, const std::vector<std::uint8_t>& gone) {
+  const std::size_t n = tool.contact_nodes.size();
+  const bool has_state = tool.tangential.size() == 3 * n;
+  std::size_t k = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    const std::int32_t node = tool.contact_nodes[s];
+    if (gone[static_cast<std::size_t>(node)]) continue;
+    tool.contact_nodes[k] = node;
+    if (has_state)
+      for (int c = 0; c < 3; ++c) tool.tangential[3 * k + c] = tool.tangential[3 * s + c];
+    ++k;
+  }
+  if (k == n) return;
+  tool.contact_nodes.resize(k);
+  if (has_state) tool.tangential.resize(3 * k);
+  tool.proximity.valid = false;
 }
 
 }  // namespace ncfsim::fem

@@ -36,10 +36,10 @@ class TriangleSurface {
 
 struct RigidSurface {
   ToolShape shape = ToolShape::Plane;
-  V3 point;          // plane point, sphere/torus centre, axis point
-  V3 axis{0, 0, 1};  // plane normal or axis (unit); the body lies on the side it points to
-  double radius = 0;       // sphere, cylinder, torus major radius, hole radius
-  double minor_radius = 0; // torus tube radius
+  V3 point;                  // plane point, sphere/torus centre, axis point
+  V3 axis{0, 0, 1};          // plane normal or axis (unit); the body lies on the side it points to
+  double radius = 0;         // sphere, cylinder, torus major radius, hole radius
+  double minor_radius = 0;   // torus tube radius
   bool body_inside = false;  // sphere/cylinder/torus: the body is inside the surface
   std::shared_ptr<const TriangleSurface> triangles;
   double search_radius = 0;  // triangles: how far to look for the nearest face
@@ -55,23 +55,23 @@ struct RigidSurface {
 /// the last rebuild. Rebuilt (a full pass over the contact nodes) once the largest node
 /// displacement plus the tool's own since then could close the margin, so no contact is missed.
 struct ToolProximity {
-  double margin = 0;                 // m; 0 until the first rebuild sets it
-  std::vector<std::int32_t> near;    // indices into RigidTool::contact_nodes
-  std::vector<double> x_ref;         // [3*n_contact_nodes] positions at the last rebuild
-  V3 tool_ref;                       // tool displacement at the last rebuild
+  double margin = 0;               // m; 0 until the first rebuild sets it
+  std::vector<std::int32_t> near;  // indices into RigidTool::contact_nodes
+  std::vector<double> x_ref;       // [3*n_contact_nodes] positions at the last rebuild
+  V3 tool_ref;                     // tool displacement at the last rebuild
   std::int64_t n_rebuilds = 0;
   bool valid = false;
 };
 
 struct ToolMotion {
   enum class Kind { Fixed, Velocity, Force } kind = Kind::Fixed;
-  V3 velocity;             // Velocity: target velocity after the ramp
-  double ramp_time = 0;    // smooth (C1) ramp from rest
-  V3 axis{0, 0, 1};        // Force: direction of the applied force and of the free motion
-  double force = 0;        // Force: magnitude (N), applied along `axis`
-  double mass = 0;         // Force: tool mass (kg)
-  double pressure = 0;     // Force given as a pressure (Pa; 0: given as a force) ...
-  double pressed_area = 0; // ... over this blank area (m^2): force = pressure x area
+  V3 velocity;              // Velocity: target velocity after the ramp
+  double ramp_time = 0;     // smooth (C1) ramp from rest
+  V3 axis{0, 0, 1};         // Force: direction of the applied force and of the free motion
+  double force = 0;         // Force: magnitude (N), applied along `axis`
+  double mass = 0;          // Force: tool mass (kg)
+  double pressure = 0;      // Force given as a pressure (Pa; 0: given as a force) ...
+  double pressed_area = 0;  // ... over this blank area (m^2): force = pressure x area
 };
 
 struct RigidTool {
@@ -79,14 +79,14 @@ struct RigidTool {
   RigidSurface surface;
   ToolMotion motion;
   std::vector<std::int32_t> contact_nodes;  // slave nodes
-  double friction = 0;        // Coulomb coefficient
-  double penalty_scale = 0.1; // k = scale * m_node / dt^2: never lowers the stable step
+  double friction = 0;                      // Coulomb coefficient
+  double penalty_scale = 0.1;  // k = scale * m_node / dt^2: never lowers the stable step
   /// Viscous damping of the normal penalty spring, share of critical 2 sqrt(k m), [0, 1]: damps
   /// contact chatter and friction-excited flutter of soft bodies sliding on the tool (a sled
   /// pulled at its top pitched into a growing normal-force oscillation without it); never pulls.
   /// Its work is reported with the friction dissipation.
   double damping = 0.1;
-  double thickness = 0;       // contact offset (shell thickness / 2 or clearance)
+  double thickness = 0;  // contact offset (shell thickness / 2 or clearance)
   /// Proximity cull margin, m; 0: automatic (1 % of the contact nodes' bounding-box diagonal,
   /// at least 4 x thickness). Larger: fewer rebuilds, more nodes tested per cycle.
   double search_margin = 0;
@@ -98,7 +98,7 @@ struct RigidTool {
   std::vector<double> tangential;   // [3*n_contact_nodes] elastic friction forces
   double friction_dissipation = 0;  // J, friction and normal damping
   std::int64_t n_active = 0;
-  double max_penetration = 0;       // deepest node past the contact offset over the run, m
+  double max_penetration = 0;  // deepest node past the contact offset over the run, m
   ToolProximity proximity;
 };
 
@@ -117,5 +117,10 @@ V3 tool_prescribed_velocity(const RigidTool& tool, double t);
 /// adds the forces on the nodes into f_contact [3*n_nodes] and updates the tool's state.
 void tool_contact_forces(RigidTool& tool, const double* x, const double* v, const double* mass,
                          double dt, double* f_contact);
+
+/// Takes the nodes flagged in `gone` ([n_nodes], 1: gone) out of the tool's contact nodes (nodes
+/// left with no element by erosion); their friction state goes with them, the near list is
+/// rebuilt in the next contact pass.
+void remove_tool_contact_nodes(RigidTool& tool, const std::vector<std::uint8_t>& gone);
 
 }  // namespace ncfsim::fem

@@ -104,6 +104,13 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   build_blocks();
   for (const auto& g : groups_)
     material_failure_ = material_failure_ || (g->can_erode() && g->material_can_fail());
+  if (erosion_enabled()) {
+    node_elements_.assign(n, 0);
+    node_freed_.assign(n, 0);
+    for (const auto& g : groups_)
+      for (std::size_t k = 0; k < g->size() * static_cast<std::size_t>(g->nodes_per_element()); ++k)
+        ++node_elements_[static_cast<std::size_t>(g->conn()[k])];
+  }
   assemble_mass();
   {  // gravity acts on the physical mass only: mass scaling adds inertia, not weight
     auto M = mass.view();
@@ -296,6 +303,7 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
 void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bool check_steps) {
   const double sf = model_.time.safety_factor;
   std::vector<std::int32_t> gone;  // mesh-wide element indices
+  std::vector<std::int32_t> orphans;
   std::vector<std::size_t> failed;
   for (std::size_t k = 0; k < groups_.size(); ++k) {
     ElementGroup& g = *groups_[k];
@@ -330,8 +338,11 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bo
           centroid(g.conn(), g.size(), e, nn, x)};
       ErodedForce& ef = eroded_forces_.emplace_back();
       ef.n_nodes = nn;
-      for (int I = 0; I < nn; ++I)
-        ef.node[I] = g.conn()[static_cast<std::size_t>(I) * g.size() + e];
+      for (int I = 0; I < nn; ++I) {
+        const std::int32_t node = g.conn()[static_cast<std::size_t>(I) * g.size() + e];
+        ef.node[I] = node;
+        if (--node_elements_[static_cast<std::size_t>(node)] == 0) orphans.push_back(node);
+      }
       g.element_force(e, x, v, ef.f);
       energy_.eroded_internal += g.erode(e);
       gone.push_back(static_cast<std::int32_t>(offset + static_cast<std::size_t>(g.set_index(e))));
@@ -341,6 +352,28 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bo
   }
   if (!gone.empty())
     for (auto& c : model_.contacts) c->erode(gone);
+  if (!orphans.empty()) free_orphan_nodes(orphans);
+}
+
+// A node no element holds would drift on with its last velocity, hit the tools and feed them
+// forces from nothing (LS-DYNA deletes such nodes with their elements). It is stopped where it is:
+// in this cycle's node update it is held like a fixed DOF, and the work of that reaction, its
+// kinetic energy, leaves the model as eroded kinetic energy; from then on a zero inverse mass
+// keeps it at rest without a branch in the node update. It leaves the tools' contact nodes (the
+// penalty contacts have already dropped it: all its faces were eroded).
+void ExplicitSolver::free_orphan_nodes(const std::vector<std::int32_t>& candidates) {
+  bool any = false;
+  for (const std::int32_t node : candidates) {
+    const auto i = static_cast<std::size_t>(node);
+    if (node_elements_[i] != 0 || node_freed_[i]) continue;
+    if (fixed_mask_[3 * i] || fixed_mask_[3 * i + 1] || fixed_mask_[3 * i + 2]) continue;
+    for (std::size_t d = 3 * i; d < 3 * i + 3; ++d) freeing_.push_back(d);
+    node_freed_[i] = 1;
+    ++n_freed_nodes_;
+    any = true;
+  }
+  if (any)
+    for (auto& tool : model_.tools) remove_tool_contact_nodes(tool, node_freed_);
 }
 
 void ExplicitSolver::assemble_mass() {
@@ -451,6 +484,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     step_ = st;
     dt_new = model_.time.safety_factor * st.dt;
     if (dt_prev_ > 0) dt_new = std::min(dt_new, 1.1 * dt_prev_);  // limit step growth
+    if (st.element < 0 && dt_prev_ > 0) dt_new = dt_prev_;        // every element eroded: no bound
     timers_.internal_force += seconds_since(t0);
 
     // Contact with rigid tools at x^n.
@@ -514,6 +548,8 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     // Constrained DOFs keep their v^{n-1/2} aside: the free update below runs over every DOF
     // without branches (it vectorises), then those DOFs are corrected.
     for (std::size_t k = 0; k < constrained_.size(); ++k) constrained_vo_[k] = vel[constrained_[k]];
+    freeing_vo_.resize(freeing_.size());
+    for (std::size_t k = 0; k < freeing_.size(); ++k) freeing_vo_[k] = vel[freeing_[k]];
     const double dtp = dt_prev_;
     // Without damping this cycle f_damp is left alone by the pass, so it is cleared once here.
     if (alpha == 0 && !f_damp_zero_) std::fill(fdamp, fdamp + nd, 0.0);
@@ -551,6 +587,22 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       con_new += fcon[d] * dt_new * dv;
       ke += 0.5 * m * vo * dv;
     }
+    // Nodes freed by erosion this cycle (free_orphan_nodes) are held at rest like a fixed DOF;
+    // the work of that reaction, -1/2 r du_old as the external work books it, is their kinetic
+    // energy (product form). Then a zero inverse mass keeps them there.
+    for (std::size_t k = 0; k < freeing_.size(); ++k) {
+      const std::size_t d = freeing_[k];
+      const double vfree = vel[d], m = mm[d], dv = -vfree, vo = freeing_vo_[k];
+      energy_.eroded_kinetic += 0.5 * m * vfree * vo * dtp * inv_dt_mid;
+      vel[d] = 0;
+      inv_mass_[d] = 0;
+      if (xfused) xfused[d] += dt_new * dv;
+      ext_new += fe[d] * dt_new * dv;
+      damp_new += fdamp[d] * dt_new * dv;
+      con_new += fcon[d] * dt_new * dv;
+      ke += 0.5 * m * vo * dv;
+    }
+    freeing_.clear();
     w_ext_.add(ext_old, ext_new);
     for (const auto& ef : eroded_forces_)  // see ErodedForce
       for (int I = 0; I < ef.n_nodes; ++I)

@@ -83,6 +83,9 @@ class ExplicitSolver {
   bool erosion_enabled() const { return model_.time.erosion_step_ratio > 0 || material_failure_; }
   /// Elements eroded so far (time.erosion_step_ratio, material failure), in order.
   const std::vector<ErosionEvent>& erosions() const { return erosions_; }
+  /// Nodes left with no element by erosion so far: they are held where they were, out of every
+  /// contact, their kinetic energy booked as EnergyBalance::eroded_kinetic.
+  std::size_t n_freed_nodes() const { return n_freed_nodes_; }
   const PhaseTimers& timers() const { return timers_; }
   std::size_t n_elements(ElementKind kind) const;
   std::size_t n_elements() const;
@@ -128,7 +131,10 @@ class ExplicitSolver {
   /// safety factor) is below dt_erode or one of whose corners has folded over (corner Jacobian
   /// <= 0); those groups' steps (group_step_) become the stable step of the elements left.
   /// Without `check_steps` only the elements the material has failed are eroded.
+  /// Nodes of eroded elements left with no element are taken out (see n_freed_nodes).
   void erode(const double* x, const double* v, double dt_erode, bool check_steps);
+  /// Takes out the nodes of `candidates` that no element holds any more and no constraint drives.
+  void free_orphan_nodes(const std::vector<std::int32_t>& candidates);
   /// "(x, y, z) m": centroid at x of the element a StableStep names (for messages).
   std::string element_position(const StableStep& st, const double* x) const;
 
@@ -139,7 +145,12 @@ class ExplicitSolver {
   PictureFrameMotion* frames_ = nullptr;                  // among motions_
   std::vector<PartMassReport> part_mass_;
   std::vector<ErosionEvent> erosions_;
-  bool material_failure_ = false;  // a group's material can fail elements
+  std::vector<std::int32_t> node_elements_;  // [n_nodes] elements (any kind) still holding it
+  std::vector<std::uint8_t> node_freed_;     // [n_nodes] 1: left with no element, taken out
+  std::size_t n_freed_nodes_ = 0;
+  std::vector<std::size_t> freeing_;  // DOFs of nodes freed this cycle (stopped in its update)
+  std::vector<double> freeing_vo_;    // their v^{n-1/2}
+  bool material_failure_ = false;     // a group's material can fail elements
   std::vector<double> step_scratch_, jacobian_scratch_;
   /// Elements eroded this cycle: their nodes and nodal internal forces at t^n. Their work over the
   /// first half of the next increment, which the trapezoidal external work counts, is booked

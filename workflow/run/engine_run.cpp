@@ -279,9 +279,13 @@ void log_end(const Run& r, const fem::ExplicitSolver& solver) {
       "energy balance at t = {:.6g} s: kinetic {:.5g} J, internal {:.5g} J (stabilisation {:.5g} "
       "J), "
       "hourglass {:.5g} J, contact {:.5g} J (friction {:.5g} J), damping {:.5g} J, external work "
-      "{:.5g} J, error {:.3g} % (limit {:.3g} %)",
+      "{:.5g} J, eroded kinetic {:.5g} J, error {:.3g} % (limit {:.3g} %)",
       en.time, en.kinetic, en.internal, en.stabilisation, en.hourglass, en.contact, en.friction,
-      en.damping, en.external_work, 100 * en.error(), 100 * tc.energy_balance_limit);
+      en.damping, en.external_work, en.eroded_kinetic, 100 * en.error(),
+      100 * tc.energy_balance_limit);
+  if (solver.n_freed_nodes() > 0)
+    r.log->info("{} nodes left with no element by erosion were taken out (held, out of contact)",
+                solver.n_freed_nodes());
   const auto& tm = solver.timers();
   const double elem_cycles =
       static_cast<double>(solver.cycle()) * static_cast<double>(solver.n_elements());

@@ -47,6 +47,8 @@ class EnergyColumns final : public fem::RunMeasure {
     if (erosion_) {
       c.push_back("eroded_elements");
       c.push_back("eroded_internal_energy_J");
+      c.push_back("eroded_kinetic_energy_J");
+      c.push_back("freed_nodes");
     }
   }
   void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override {
@@ -58,6 +60,8 @@ class EnergyColumns final : public fem::RunMeasure {
     if (erosion_) {
       row.push_back(static_cast<double>(s.erosions().size()));
       row.push_back(en.eroded_internal);
+      row.push_back(en.eroded_kinetic);
+      row.push_back(static_cast<double>(s.n_freed_nodes()));
     }
   }
 

@@ -12,7 +12,8 @@ namespace {
 std::atomic<int> g_stop{0};
 extern "C" void on_sigint(int) {
   if (g_stop.fetch_add(1) >= 1) std::_Exit(130);
-  static const char msg[] = "\n[ncfsim] interrupt: stopping after this cycle (Ctrl-C again to abort)\n";
+  static const char msg[] =
+      "\n[ncfsim] interrupt: stopping after this cycle (Ctrl-C again to abort)\n";
   [[maybe_unused]] auto r = ::write(2, msg, sizeof msg - 1);
 }
 }  // namespace

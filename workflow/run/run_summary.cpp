@@ -84,6 +84,8 @@ void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json
       en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
   summary["eroded_elements"] = solver.erosions().size();
   summary["eroded_internal_energy_J"] = en.eroded_internal;
+  summary["eroded_kinetic_energy_J"] = en.eroded_kinetic;
+  summary["freed_nodes"] = solver.n_freed_nodes();
   const auto& tm = solver.timers();
   summary["timers_s"] = {{"internal_force", tm.internal_force},
                          {"contact", tm.contact},
