@@ -15,6 +15,10 @@ struct WorkAccumulator {
   }
 };
 
+/// Energies below this are round-off for the balance (J); the smallest physical energies of the
+/// project's models (a single tow bent by its weight) are ~1e-7 J.
+inline constexpr double kEnergyScaleFloor = 1e-12;
+
 struct EnergyBalance {
   double time = 0;
   double kinetic = 0;
@@ -31,10 +35,17 @@ struct EnergyBalance {
   double eroded_kinetic = 0;   // kinetic energy of nodes left with no element by erosion when
                                // they were taken out of the model (they stop and leave contact)
 
+  /// The largest energy in play so far in the run (see scale(); updated by the solver each cycle).
+  double scale_max = 0;
+
   double total() const {
     return kinetic + internal + hourglass + contact + damping + eroded_kinetic;
   }
-  /// |E - E0 - W_ext| over the largest energy in play.
+  /// The energy in play now: max(|E0| + |W_ext|, sum of the magnitudes of the terms), J.
+  double scale() const;
+  /// |E - E0 - W_ext| over the largest energy in play over the run so far (scale_max), at least
+  /// kEnergyScaleFloor: a run whose energies are all near zero (a tool still closing, a model at
+  /// rest) has round-off residuals of 1e-20 J that mean nothing, not a 100 % error.
   double error() const;
 };
 

@@ -657,6 +657,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
     for (const auto& c : model_.contacts) fr += c->friction_dissipation();
     energy_.friction = fr;
+    energy_.scale_max = std::max(energy_.scale_max, energy_.scale());
     if (!std::isfinite(ke)) check_finite(Vv.data());
     timers_.update += seconds_since(t0);
   }
