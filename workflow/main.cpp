@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
 #include "fem/errors.hpp"
 #include "fem/petsc_vector.hpp"
@@ -20,6 +22,7 @@
 #include "workflow/run/engine_run.hpp"
 #include "workflow/stages/stage_registry.hpp"
 #include "workflow/stages/transfer_export.hpp"
+#include "workflow/stages/workflow_stage.hpp"
 #include "workflow/version.hpp"
 
 namespace wf = ncfsim::workflow;
@@ -59,12 +62,17 @@ int main(int argc, char** argv) {
   run->add_option("case", case_file, "Case file (TOML)")->required();
   run->add_option("-o,--output", out_dir, "Output folder (default results/<case name>)")
       ->check(CLI::Validator(
-          [](const std::string& s) { return s.empty() ? std::string("an empty output folder") : std::string(); },
+          [](const std::string& s) {
+            return s.empty() ? std::string("an empty output folder") : std::string();
+          },
           "FOLDER"));
   run->add_option("--set", overrides,
                   "Override a case key: --set KEY=VALUE (repeatable), e.g. "
                   "--set mesh.resolution=coarse");
   run->add_option("--np", ranks, "MPI ranks (default 1)")->check(CLI::Range(1, 1 << 20));
+  std::vector<std::string> force_stages;
+  run->add_option("--force", force_stages,
+                  "Workflow: rerun this stage although its inputs have not changed (repeatable)");
   run->add_option("--progress-interval", progress, "Seconds between progress lines (default 5)")
       ->check(CLI::Validator(
           [](const std::string& s) {
@@ -75,7 +83,8 @@ int main(int argc, char** argv) {
               return std::string("not a number");
             }
             // NaN passes CLI11's PositiveNumber and Range (every comparison with it is false)
-            return std::isfinite(v) && v > 0 ? std::string() : std::string("must be a finite number > 0");
+            return std::isfinite(v) && v > 0 ? std::string()
+                                             : std::string("must be a finite number > 0");
           },
           "SECONDS"));
 
@@ -185,6 +194,7 @@ int main(int argc, char** argv) {
       call.options.overrides = overrides;
       call.options.ranks = ranks;
       call.options.progress_interval_s = progress;
+      call.options.force_stages = force_stages;
       return wf::run_stage(call);
     }
     if (*cal_stitch) {
@@ -217,13 +227,18 @@ int main(int argc, char** argv) {
     if (*exporter) {
       require_output_folder(folder);
       const auto r = wf::export_impregnated(folder, deck_format);
-      std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs\n", r.file.c_str(), r.nodes,
-                  r.elements, r.materials, r.tie_pairs);
+      std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs\n", r.file.c_str(),
+                  r.nodes, r.elements, r.materials, r.tie_pairs);
       return wf::kSuccess;
     }
     if (*report) {
       require_output_folder(folder);
-      wf::write_report(folder);
+      std::ifstream sum(std::filesystem::path(folder) / "summary.json");
+      const auto js = nlohmann::json::parse(sum, nullptr, false);
+      if (js.is_object() && js.value("stage", "") == "workflow")
+        wf::write_workflow_report(folder);
+      else
+        wf::write_report(folder);
       std::printf("%s\n", (std::filesystem::path(folder) / "report.html").c_str());
       return wf::kSuccess;
     }

@@ -25,6 +25,12 @@ std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out
     file->set_pattern("[%Y-%m-%d %H:%M:%S] %v");
     file->set_level(v == Verbosity::Verbose ? spdlog::level::debug : spdlog::level::info);
     sinks.push_back(file);
+    // The warnings alone, for the workflow's report (one list over every stage).
+    auto warnings = std::make_shared<spdlog::sinks::basic_file_sink_mt>(
+        (out_dir / "warnings.txt").string(), true);
+    warnings->set_pattern("%v");
+    warnings->set_level(spdlog::level::warn);
+    sinks.push_back(warnings);
   }
   auto log = std::make_shared<spdlog::logger>("ncfsim", sinks.begin(), sinks.end());
   log->set_level(spdlog::level::debug);

@@ -16,6 +16,7 @@ struct RunOptions {
   double progress_interval_s = 5.0;   // wall seconds between progress lines
   std::vector<std::string> overrides; // --set items, echoed into summary.json
   int ranks = 1;                      // --np: MPI ranks requested
+  std::vector<std::string> force_stages;  // --force: workflow stages rerun although unchanged
 };
 
 /// Exit codes of the command line (docs/cli.md).

@@ -10,6 +10,7 @@
 #include "workflow/run/run_summary.hpp"
 #include "workflow/stages/kinematic_drape_stage.hpp"
 #include "workflow/stages/transfer_stage.hpp"
+#include "workflow/stages/workflow_stage.hpp"
 #include "workflow/version.hpp"
 
 namespace ncfsim::workflow {
@@ -85,12 +86,16 @@ const std::vector<Stage>& stages() {
       {"transfer",
        "draped tows to the impregnated composite model (micromechanics, Vf from compaction, ties)",
        &run_transfer_stage, &check_transfer_stage},
+      {"workflow",
+       "stages (drape, fishnet, transfer, crush, ...) from case files of their own into one "
+       "folder, unchanged stages skipped, one report",
+       &run_workflow_stage, &check_workflow_stage},
   };
   return registry;
 }
 
 const std::vector<std::string>& planned_stage_kinds() {
-  static const std::vector<std::string> planned{"workflow"};
+  static const std::vector<std::string> planned{};
   return planned;
 }
 
@@ -103,7 +108,7 @@ const Stage& find_stage(const std::string& kind, const std::filesystem::path& fi
   for (const auto& p : planned_stage_kinds()) planned += (planned.empty() ? "" : ", ") + p;
   throw InputError(file.string(), "case.kind",
                    "'" + kind + "' is not a stage kind; allowed: " + allowed +
-                       " (planned, not in this build: " + planned + ")");
+                       (planned.empty() ? "" : " (planned, not in this build: " + planned + ")"));
 }
 
 std::string case_kind(const std::filesystem::path& file,

@@ -1,0 +1,567 @@
+#include "workflow/stages/workflow_stage.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/logger.h>
+#include <vtksys/MD5.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "fem/case/toml_reader.hpp"
+#include "fem/errors.hpp"
+#include "fem/petsc_vector.hpp"
+#include "workflow/output/output_files.hpp"
+#include "workflow/render/render.hpp"
+#include "workflow/run/run_output.hpp"
+#include "workflow/stages/workflow_case.hpp"
+#include "workflow/version.hpp"
+
+namespace ncfsim::workflow {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+constexpr const char* kInputsFile = "stage_inputs.json";
+
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  if (!in) return json();
+  try {
+    return json::parse(in);
+  } catch (const json::exception&) {
+    return json();
+  }
+}
+
+class Md5 {
+ public:
+  Md5() : h_(vtksysMD5_New()) { vtksysMD5_Initialize(h_); }
+  ~Md5() { vtksysMD5_Delete(h_); }
+  Md5(const Md5&) = delete;
+  Md5& operator=(const Md5&) = delete;
+  void add(const std::string& s) {
+    // Length first: ("ab", "c") and ("a", "bc") must differ.
+    const std::string len = std::to_string(s.size()) + ":";
+    vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(len.data()),
+                     static_cast<int>(len.size()));
+    vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(s.data()),
+                     static_cast<int>(s.size()));
+  }
+  std::string hex() {
+    char out[33] = {};
+    vtksysMD5_FinalizeHex(h_, out);
+    return std::string(out, 32);
+  }
+
+ private:
+  vtksysMD5* h_;
+};
+
+// String values of a TOML tree (any depth), with their key paths.
+void string_values(const toml::node& n, const std::string& path,
+                   std::vector<std::pair<std::string, std::string>>& out) {
+  if (const auto* t = n.as_table()) {
+    for (const auto& [k, v] : *t)
+      string_values(v, path.empty() ? std::string(k.str()) : path + "." + std::string(k.str()),
+                    out);
+  } else if (const auto* a = n.as_array()) {
+    for (std::size_t i = 0; i < a->size(); ++i)
+      string_values(*a->get(i), path + "[" + std::to_string(i) + "]", out);
+  } else if (const auto* s = n.as_string()) {
+    out.emplace_back(path, s->get());
+  }
+}
+
+struct StagePlan {
+  WorkflowStageSpec spec;
+  fs::path folder;
+  std::vector<std::string> overrides;  // routed + inputs
+  std::string kind;
+  std::string hash;
+  json inputs;  // what the hash covers (stage_inputs.json)
+};
+
+// The stage's inputs and their hash; the upstream hashes are those of plans already made.
+void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream_hash) {
+  const fem::CaseDocument doc = fem::CaseDocument::load(p.spec.case_file, p.overrides);
+  std::ostringstream resolved;
+  resolved << doc.root();
+  Md5 md5;
+  md5.add(kVersion);
+  md5.add(resolved.str());
+  std::set<std::string> input_keys;
+  for (const auto& [key, up] : p.spec.inputs) input_keys.insert(key);
+  std::vector<std::pair<std::string, std::string>> strings;
+  string_values(doc.root(), "", strings);
+  json files = json::array();
+  const fs::path dir = p.spec.case_file.parent_path();
+  for (const auto& [key, value] : strings) {
+    if (input_keys.count(key) || value.empty() || value.size() > 4096) continue;
+    std::error_code ec;
+    const fs::path f = fs::path(value).is_absolute() ? fs::path(value) : dir / value;
+    if (!fs::is_regular_file(f, ec)) continue;
+    md5.add(key);
+    md5.add(read_bytes(f));
+    files.push_back(f.lexically_normal().string());
+  }
+  json up = json::object();
+  for (const auto& u : p.spec.after) {
+    md5.add(u);
+    md5.add(upstream_hash.at(u));
+    up[u] = upstream_hash.at(u);
+  }
+  p.hash = md5.hex();
+  p.inputs = {{"hash", p.hash},
+              {"ncfsim_version", kVersion},
+              {"case_file", p.spec.case_file.lexically_normal().string()},
+              {"overrides", p.overrides},
+              {"files", files},
+              {"upstream", up}};
+}
+
+bool unchanged(const StagePlan& p) {
+  const json old = read_json(p.folder / kInputsFile);
+  const json sum = read_json(p.folder / "summary.json");
+  return old.is_object() && old.value("hash", "") == p.hash && sum.is_object() &&
+         sum.value("status", "") == "completed";
+}
+
+std::string hms(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  const long t = std::lround(s);
+  return fmt::format("{:02d}:{:02d}:{:02d}", t / 3600, (t / 60) % 60, t % 60);
+}
+
+std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out) {
+  std::vector<StagePlan> plans;
+  std::map<std::string, std::string> hashes;
+  for (const auto& s : wc.stages) {
+    StagePlan p;
+    p.spec = s;
+    p.folder = out / s.name;
+    p.overrides = s.overrides;
+    for (const auto& [key, up] : s.inputs)
+      p.overrides.push_back(key + "=" +
+                            json(fs::absolute(out / up / "results.h5").string()).dump());
+    p.kind = case_kind(s.case_file, p.overrides);
+    if (p.kind == "workflow")
+      throw InputError(
+          wc.file.string(), "stage",
+          "stage '" + s.name + "' is itself a workflow (" + s.case_file.string() + ")");
+    find_stage(p.kind, s.case_file);  // a known kind, or bad input naming the stage's file
+    hash_stage(p, hashes);
+    hashes[s.name] = p.hash;
+    plans.push_back(std::move(p));
+  }
+  return plans;
+}
+
+}  // namespace
+
+int run_workflow_stage(const StageCall& call) {
+  const WorkflowCase wc = load_workflow_case(call.case_file, call.overrides);
+  const fs::path out = output_folder(wc.name, call.options);
+  for (const auto& f : call.options.force_stages)
+    if (std::none_of(wc.stages.begin(), wc.stages.end(),
+                     [&](const auto& s) { return s.name == f; }))
+      throw InputError(call.case_file.string(), "--force",
+                       "'" + f + "' is not a stage of this workflow");
+  const std::vector<StagePlan> plans = plan(wc, out);
+  // One PETSc/MPI session over every stage: MPI cannot start again once a stage's own session
+  // has finalised it (the stages' sessions nest in this one).
+  fem::PetscSession petsc;
+  if (const int rc = refuse_many_ranks()) return rc;
+  fs::create_directories(out);
+  auto log = make_run_logger(out, call.options.verbosity);
+  StopRequest::install();
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto wall = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  log->info("workflow '{}' ({}): {} stages into {}", wc.name, call.case_file.string(), plans.size(),
+            out.string());
+
+  json summary = stage_summary_header(wc.name, call, "workflow");
+  summary["status"] = "running";
+  summary["stages"] = json::array();
+  const std::size_t n = plans.size();
+  // Stage estimates for the ETA: the wall time of its last completed run, where there is one.
+  std::vector<double> estimate(n, -1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const json old = read_json(plans[k].folder / "summary.json");
+    if (old.is_object() && old.contains("wall_seconds") && old["wall_seconds"].is_number())
+      estimate[k] = old["wall_seconds"].get<double>();
+  }
+  int code = kSuccess;
+  std::string stop_reason;
+  for (std::size_t k = 0; k < n; ++k) {
+    const StagePlan& p = plans[k];
+    const std::string tag = fmt::format("[{}/{} {}]", k + 1, n, p.spec.name);
+    json entry = {{"name", p.spec.name},
+                  {"kind", p.kind},
+                  {"case_file", p.spec.case_file.string()},
+                  {"folder", p.spec.name},
+                  {"inputs_hash", p.hash}};
+    if (!stop_reason.empty()) {
+      entry["status"] = "not_run";
+      summary["stages"].push_back(entry);
+      continue;
+    }
+    const bool forced =
+        std::find(call.options.force_stages.begin(), call.options.force_stages.end(),
+                  p.spec.name) != call.options.force_stages.end();
+    if (!forced && unchanged(p)) {
+      log->info("{} unchanged since its last run (inputs {}): skipped, results in {}", tag,
+                p.hash.substr(0, 12), p.folder.string());
+      entry["status"] = "skipped";
+      entry["wall_seconds"] = 0.0;
+      summary["stages"].push_back(entry);
+      estimate[k] = 0;
+      continue;
+    }
+    double left = 0;
+    bool known = true;
+    for (std::size_t j = k; j < n; ++j) {
+      known = known && estimate[j] >= 0;
+      left += std::max(0.0, estimate[j]);
+    }
+    log->info("{} {} {} -> {}{} | workflow wall {} | ETA {}", tag, forced ? "forced:" : "running",
+              p.spec.case_file.string(), p.folder.string(),
+              p.overrides.empty() ? "" : " (with --set)", hms(wall()),
+              known ? hms(left) + " (from the last run's stage times)" : "unknown (first run)");
+    for (const auto& o : p.overrides) log->debug("{}   --set {}", tag, o);
+    fs::create_directories(p.folder);
+    fs::remove(p.folder / kInputsFile);  // a stage stopped half-way is never taken as done
+    StageCall sc;
+    sc.case_file = p.spec.case_file;
+    sc.overrides = p.overrides;
+    sc.options = call.options;
+    sc.options.out_dir = p.folder;
+    sc.options.overrides = p.overrides;
+    sc.options.force_stages.clear();
+    const double ts = wall();
+    int rc = kOtherError;
+    std::string error;
+    try {
+      rc = find_stage(p.kind, p.spec.case_file).run(sc);
+    } catch (const InputError& e) {
+      rc = kBadInput;
+      error = e.what();
+      log->error("{} bad input: {}", tag, e.what());
+    } catch (const NumericalError& e) {
+      rc = kNumericalFailure;
+      error = e.what();
+      log->error("{} numerical failure: {}", tag, e.what());
+    }
+    const json ss = read_json(p.folder / "summary.json");
+    std::string status = ss.is_object() ? ss.value("status", "failed") : "failed";
+    if (rc == kBadInput)
+      status = "bad_input";  // found before the stage wrote its summary
+    else if (rc == kNumericalFailure && status == "completed")
+      status = "numerical_failure";
+    else if (rc != kSuccess && status == "completed")
+      status = "failed";
+    entry["wall_seconds"] = wall() - ts;
+    entry["status"] = status;
+    if (!error.empty()) entry["error"] = error;
+    summary["stages"].push_back(entry);
+    if (rc == kSuccess && status == "completed") {
+      write_file_atomically(p.folder / kInputsFile, p.inputs.dump(2) + "\n");
+      log->info("{} completed in {}", tag, hms(wall() - ts));
+    } else {
+      code = rc == kSuccess ? kOtherError : rc;
+      stop_reason = fmt::format("stage '{}' ended {} (exit {})", p.spec.name, status, rc);
+    }
+    if (StopRequest::requested() && stop_reason.empty() && k + 1 < n)
+      stop_reason = "interrupted (SIGINT/SIGTERM)";
+    if (!stop_reason.empty() && StopRequest::requested()) code = kOtherError;
+  }
+  summary["wall_seconds"] = wall();
+  summary["status"] = stop_reason.empty()        ? "completed"
+                      : StopRequest::requested() ? "interrupted"
+                                                 : "failed";
+  if (!stop_reason.empty()) summary["error"] = stop_reason;
+  write_file_atomically(out / "summary.json", summary.dump(2) + "\n");
+  try {
+    write_workflow_report(out);
+    log->info("report: {}", (out / "report.html").string());
+  } catch (const std::exception& e) {
+    log->warn("report not written: {}", e.what());
+  }
+  if (!stop_reason.empty()) {
+    std::string kept;
+    for (const auto& e : summary["stages"])
+      if (e["status"] == "completed" || e["status"] == "skipped")
+        kept += (kept.empty() ? "" : ", ") + e["name"].get<std::string>();
+    log->warn(
+        "workflow stopped: {}; kept: {} (their results stand); {} the same command to go "
+        "on: the kept stages are skipped",
+        stop_reason, kept.empty() ? "none" : kept,
+        code == kBadInput ? "correct the input and rerun" : "rerun");
+  } else {
+    log->info("workflow '{}' completed in {}: {}", wc.name, hms(wall()), out.string());
+  }
+  return code;
+}
+
+int check_workflow_stage(const StageCall& call) {
+  const WorkflowCase wc = load_workflow_case(call.case_file, call.overrides);
+  fem::PetscSession petsc;  // see run_workflow_stage
+  if (const int rc = refuse_many_ranks()) return rc;
+  std::string list;
+  for (const auto& s : wc.stages) {
+    StageCall sc;
+    sc.case_file = s.case_file;
+    sc.overrides = s.overrides;
+    const std::string kind = case_kind(s.case_file, s.overrides);
+    if (kind == "workflow")
+      throw InputError(call.case_file.string(), "stage",
+                       "stage '" + s.name + "' is itself a workflow");
+    const Stage& st = find_stage(kind, s.case_file);
+    if (s.inputs.empty()) {
+      if (const int rc = st.check(sc)) return rc;
+    } else {  // its inputs do not exist before the upstream stages ran: the case must parse
+      fem::CaseDocument::load(s.case_file, s.overrides);
+      std::printf("%s: parsed (stage '%s' reads the results of %s when it runs)\n",
+                  s.case_file.c_str(), s.name.c_str(), s.inputs.front().second.c_str());
+    }
+    list += (list.empty() ? "" : " -> ") + s.name;
+  }
+  std::printf("%s: OK (workflow '%s': %s)\n", call.case_file.c_str(), wc.name.c_str(),
+              list.c_str());
+  return kSuccess;
+}
+
+// ---------------------------------------------------------------------------------------------
+// report.html of a workflow
+
+namespace {
+
+std::string escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        o += "&amp;";
+        break;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
+    }
+  }
+  return o;
+}
+
+std::string number(const json& s, const std::string& key, const char* fmt_spec = "{:.4g}") {
+  if (!s.is_object() || !s.contains(key) || !s[key].is_number()) return "-";
+  return fmt::format(fmt::runtime(fmt_spec), s[key].get<double>());
+}
+
+// The shear rings of every stage that measured one, on one plot (the meso drape's own column
+// shear_deg, a kinematic drape's kinematic_shear_deg).
+bool ring_plot(const fs::path& dir, const json& stages, std::string& why) {
+  render::CurvePlot plot;
+  plot.title = "Shear angle round the ring";
+  plot.x_label = "azimuth [deg]";
+  plot.y_label = "shear angle [deg]";
+  for (const auto& e : stages) {
+    const fs::path csv = dir / e["folder"].get<std::string>() / "ring_shear.csv";
+    if (!fs::exists(csv)) continue;
+    try {
+      const CsvTable t = read_csv(csv);
+      const auto az = t.column("azimuth_deg");
+      const bool kinematic = e["kind"] == "kinematic_drape";
+      const auto y = t.column(kinematic ? "kinematic_shear_deg" : "shear_deg");
+      render::CurveSeries s;
+      s.label = e["name"].get<std::string>() + (kinematic ? " (pin-jointed net)" : "");
+      s.dashed = kinematic;
+      for (std::size_t i = 0; i < az.size(); ++i)
+        if (std::isfinite(y[i])) s.x.push_back(az[i]), s.y.push_back(y[i]);
+      plot.series.push_back(std::move(s));
+    } catch (const std::exception& ex) {
+      why = csv.string() + ": " + ex.what();
+    }
+  }
+  if (plot.series.empty()) return false;
+  fs::create_directories(dir / "figures");
+  render::plot_curves_png(plot, dir / "figures" / "ring_shear_compared.png");
+  return true;
+}
+
+}  // namespace
+
+void write_workflow_report(const fs::path& dir) {
+  const json s = read_json(dir / "summary.json");
+  if (!s.is_object() || !s.contains("stages"))
+    throw std::runtime_error((dir / "summary.json").string() + " is not a workflow's summary");
+  const std::string name = s.value("case", "workflow");
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape(name)
+    << " - ncfsim workflow</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em "
+       "auto;color:#222}table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid "
+       "#bbb;padding:3px 8px;text-align:left;font-size:90%}img{max-width:100%;border:1px solid "
+       "#ddd;margin:6px 0}.bad{color:#b00;font-weight:bold}.ok{color:#070;font-weight:bold}"
+       "</style></head><body>\n";
+  const std::string status = s.value("status", "unknown");
+  h << "<h1>" << escape(name) << "</h1>\n<p>ncfsim " << escape(s.value("ncfsim_version", "?"))
+    << " &middot; workflow " << escape(s.value("case_file", ""))
+    << " &middot; status <span class=\"" << (status == "completed" ? "ok" : "bad") << "\">"
+    << escape(status) << "</span> &middot; wall " << hms(s.value("wall_seconds", 0.0)) << "</p>\n";
+  if (s.contains("error"))
+    h << "<p class=\"bad\">" << escape(s["error"].get<std::string>()) << "</p>\n";
+
+  std::map<std::string, json> sums;
+  for (const auto& e : s["stages"])
+    sums[e["name"].get<std::string>()] =
+        read_json(dir / e["folder"].get<std::string>() / "summary.json");
+
+  h << "<h2>Process</h2>\n<table><tr><th>stage</th><th>kind</th><th>case</th><th>this run</th>"
+       "<th>wall (this run)</th><th>wall (stage)</th><th>energy balance "
+       "error</th><th>report</th></tr>\n";
+  for (const auto& e : s["stages"]) {
+    const std::string st = e.value("status", "?"), nm = e["name"].get<std::string>();
+    const json& ss = sums[nm];
+    std::string balance = "-";
+    if (ss.is_object() && ss.contains("energy_balance_error") &&
+        ss["energy_balance_error"].is_number()) {
+      const double err = ss["energy_balance_error"].get<double>();
+      const double lim = ss.value("energy_balance_limit", 0.05);
+      balance = fmt::format("<span class=\"{}\">{:.3g} %</span> (limit {:.3g} %)",
+                            err <= lim ? "ok" : "bad", 100 * err, 100 * lim);
+    }
+    h << "<tr><td>" << escape(nm) << "</td><td>" << escape(e.value("kind", "")) << "</td><td>"
+      << escape(e.value("case_file", "")) << "</td><td class=\""
+      << (st == "completed" || st == "skipped" ? "ok" : "bad") << "\">" << escape(st) << "</td><td>"
+      << hms(e.value("wall_seconds", 0.0)) << "</td><td>"
+      << (ss.is_object() ? hms(ss.value("wall_seconds", 0.0)) : "-") << "</td><td>" << balance
+      << "</td><td>"
+      << (fs::exists(dir / nm / "report.html")
+              ? "<a href=\"" + escape(nm) + "/report.html\">report</a>"
+              : "-")
+      << "</td></tr>\n";
+  }
+  h << "</table>\n";
+
+  // The drapes compared: rings and quadrant maxima.
+  std::string why;
+  bool any_ring = false;
+  try {
+    any_ring = ring_plot(dir, s["stages"], why);
+  } catch (const std::exception& ex) {
+    why = ex.what();
+  }
+  std::ostringstream q;
+  for (const auto& e : s["stages"]) {
+    const std::string nm = e["name"].get<std::string>();
+    const json& ss = sums[nm];
+    for (const char* prefix : {"", "kinematic_"}) {
+      if (!ss.is_object() || !ss.contains(std::string(prefix) + "max_shear_deg_q1")) continue;
+      q << "<tr><td>" << escape(nm) << (*prefix ? " (pin-jointed net)" : "") << "</td>";
+      for (int k = 1; k <= 4; ++k)
+        q << "<td>" << number(ss, fmt::format("{}max_shear_deg_q{}", prefix, k), "{:.1f}")
+          << "</td>";
+      q << "</tr>\n";
+    }
+  }
+  if (any_ring || !q.str().empty()) {
+    h << "<h2>Drapes compared: shear angle on the ring</h2>\n";
+    if (any_ring)
+      h << "<figure><img src=\"figures/ring_shear_compared.png\" alt=\"ring "
+           "shear\"><figcaption>shear "
+           "angle round the ring, every drape of the workflow</figcaption></figure>\n";
+    else if (!why.empty())
+      h << "<p class=\"bad\">ring plot: " << escape(why) << "</p>\n";
+    if (!q.str().empty())
+      h << "<table><tr><th>drape</th><th>max q1 [deg]</th><th>max q2 [deg]</th><th>max q3 "
+           "[deg]</th><th>max q4 [deg]</th></tr>\n"
+        << q.str() << "</table>\n";
+  }
+
+  // Key results.
+  static const std::vector<std::pair<const char*, const char*>> keys{
+      {"punch_displacement_m", "punch stroke [m]"},
+      {"kinetic_to_internal_max", "kinetic / internal, max"},
+      {"elements_mapped", "elements mapped"},
+      {"vf_mean", "fibre volume fraction, mean"},
+      {"vf_min", "fibre volume fraction, min"},
+      {"vf_max", "fibre volume fraction, max"},
+      {"tie_pairs", "resin tie pairs"},
+      {"peak_force_N", "peak punch force [N]"},
+      {"stroke_at_peak_m", "stroke at peak [m]"},
+      {"energy_absorbed_J", "energy absorbed [J]"},
+      {"dominant_failure_mode", "dominant failure mode"}};
+  h << "<h2>Key results</h2>\n<table><tr><th>stage</th><th>quantity</th><th>value</th></tr>\n";
+  for (const auto& e : s["stages"]) {
+    const std::string nm = e["name"].get<std::string>();
+    const json& ss = sums[nm];
+    if (!ss.is_object()) continue;
+    for (const auto& [k, label] : keys)
+      if (ss.contains(k))
+        h << "<tr><td>" << escape(nm) << "</td><td>" << label << "</td><td>"
+          << escape(ss[k].is_number() ? fmt::format("{:.4g}", ss[k].get<double>()) : ss[k].dump())
+          << "</td></tr>\n";
+  }
+  h << "</table>\n";
+
+  // Every stage's figures (formed part by shear angle, Vf map, failure modes, force curves, energy
+  // balances).
+  for (const auto& e : s["stages"]) {
+    const std::string nm = e["name"].get<std::string>();
+    const fs::path figs = dir / nm / "figures";
+    if (!fs::is_directory(figs)) continue;
+    std::vector<std::string> pngs;
+    for (const auto& f : fs::directory_iterator(figs))
+      if (f.path().extension() == ".png") pngs.push_back(f.path().filename().string());
+    std::sort(pngs.begin(), pngs.end());
+    if (pngs.empty()) continue;
+    h << "<h2>" << escape(nm) << " (" << escape(e.value("kind", "")) << ")</h2>\n";
+    for (const auto& f : pngs)
+      h << "<figure><img src=\"" << escape(nm) << "/figures/" << escape(f) << "\" alt=\""
+        << escape(f) << "\"><figcaption>" << escape(nm) << ": " << escape(f)
+        << "</figcaption></figure>\n";
+  }
+
+  // Warnings of every stage.
+  std::ostringstream w;
+  std::size_t n_warn = 0;
+  for (const auto& e : s["stages"]) {
+    const std::string nm = e["name"].get<std::string>();
+    std::ifstream in(dir / nm / "warnings.txt");
+    std::string line;
+    while (std::getline(in, line))
+      if (!line.empty()) w << "<li>[" << escape(nm) << "] " << escape(line) << "</li>\n", ++n_warn;
+  }
+  h << "<h2>Warnings (" << n_warn << ")</h2>\n";
+  if (n_warn == 0)
+    h << "<p>None.</p>\n";
+  else
+    h << "<ul>\n" << w.str() << "</ul>\n";
+  h << "<p><a href=\"summary.json\">summary.json</a> &middot; <a href=\"log.txt\">log.txt</a></p>\n"
+       "</body></html>\n";
+  write_file_atomically(dir / "report.html", h.str());
+}
+
+}  // namespace ncfsim::workflow
