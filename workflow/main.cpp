@@ -71,6 +71,10 @@ int main(int argc, char** argv) {
                   "--set mesh.resolution=coarse");
   run->add_option("--np", ranks, "MPI ranks (default 1)")->check(CLI::Range(1, 1 << 20));
   std::vector<std::string> force_stages;
+  bool overwrite = false;
+  run->add_flag("--overwrite", overwrite,
+                "Write into an output folder that holds files ncfsim did not write (those of the "
+                "same names are replaced, nothing else is touched)");
   run->add_option("--force", force_stages,
                   "Workflow: rerun this stage although its inputs have not changed (repeatable)");
   run->add_option("--progress-interval", progress, "Seconds between progress lines (default 5)")
@@ -195,6 +199,7 @@ int main(int argc, char** argv) {
       call.options.ranks = ranks;
       call.options.progress_interval_s = progress;
       call.options.force_stages = force_stages;
+      call.options.overwrite = overwrite;
       return wf::run_stage(call);
     }
     if (*cal_stitch) {

@@ -4,10 +4,12 @@
 #include <spdlog/sinks/basic_file_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
+#include "fem/errors.hpp"
 #include "fem/io/atomic_file.hpp"
 
 namespace ncfsim::workflow {
@@ -91,6 +93,115 @@ CsvTable read_csv(const std::filesystem::path& file) {
     if (row.size() == t.columns.size()) t.rows.push_back(std::move(row));  // skip a torn last line
   }
   return t;
+}
+
+namespace {
+
+constexpr const char* kManifest = ".ncfsim_manifest.json";
+
+// Files and folders under dir (relative, generic form), skipping the manifest and the entries
+// named in keep (at the top level).
+void list_tree(const std::filesystem::path& dir, const std::vector<std::string>& keep,
+               std::vector<std::string>& files, std::vector<std::string>& dirs) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    const std::string rel = fs::relative(it->path(), dir).generic_string();
+    if (it.depth() == 0 &&
+        (rel == kManifest || std::find(keep.begin(), keep.end(), rel) != keep.end())) {
+      if (it->is_directory()) it.disable_recursion_pending();
+      continue;
+    }
+    (it->is_directory() ? dirs : files).push_back(rel);
+  }
+  std::sort(files.begin(), files.end());
+  std::sort(dirs.begin(), dirs.end());
+}
+
+bool listed(const std::vector<std::string>& sorted, const std::string& s) {
+  return std::binary_search(sorted.begin(), sorted.end(), s);
+}
+
+}  // namespace
+
+OutputFolder OutputFolder::claim(const std::filesystem::path& dir, bool overwrite,
+                                 const std::vector<std::string>& keep) {
+  namespace fs = std::filesystem;
+  OutputFolder o;
+  o.dir_ = dir;
+  o.keep_ = keep;
+  if (fs::exists(dir) && !fs::is_directory(dir))
+    throw InputError(dir.string(), "-o", "is a file, not a folder");
+  fs::create_directories(dir);
+  const fs::path manifest = dir / kManifest;
+  if (fs::exists(manifest)) {
+    nlohmann::json m;
+    try {
+      std::ifstream in(manifest);
+      m = nlohmann::json::parse(in);
+    } catch (const std::exception&) {
+      throw InputError(manifest.string(), "", "cannot be read: remove it, or give another folder");
+    }
+    std::vector<std::string> files, dirs;
+    list_tree(dir, keep, files, dirs);
+    std::vector<std::string> ours, keep_files = m.value("before_files", std::vector<std::string>{}),
+                                   keep_dirs = m.value("before_dirs", std::vector<std::string>{});
+    std::sort(keep_files.begin(), keep_files.end());
+    std::sort(keep_dirs.begin(), keep_dirs.end());
+    if (m.value("complete", false)) {  // exactly what it lists
+      for (const auto& f : m.value("files", std::vector<std::string>{})) fs::remove(dir / f);
+      ours = m.value("dirs", std::vector<std::string>{});
+    } else {  // a run that died: everything that was not there before it
+      for (const auto& f : files)
+        if (!listed(keep_files, f)) fs::remove(dir / f);
+      for (const auto& d : dirs)
+        if (!listed(keep_dirs, d)) ours.push_back(d);
+    }
+    std::sort(ours.rbegin(), ours.rend());  // deepest first; a folder left non-empty stays
+    for (const auto& d : ours) {
+      std::error_code ec;
+      fs::remove(dir / d, ec);
+    }
+    fs::remove(manifest);
+  } else if (!overwrite) {
+    std::vector<std::string> files, dirs;
+    list_tree(dir, keep, files, dirs);
+    if (!files.empty() || !dirs.empty())
+      throw InputError(dir.string(), "-o",
+                       "holds files ncfsim did not write (e.g. " +
+                           (files.empty() ? dirs.front() : files.front()) +
+                           "): give an empty or new output folder, or --overwrite to write beside "
+                           "them (files of the same names are replaced, nothing else is touched)");
+  }
+  list_tree(dir, keep, o.before_files_, o.before_dirs_);
+  o.start_ = fs::file_time_type::clock::now();
+  const nlohmann::json m = {
+      {"complete", false}, {"before_files", o.before_files_}, {"before_dirs", o.before_dirs_}};
+  write_file_atomically(manifest, m.dump(1) + "\n");
+  return o;
+}
+
+void OutputFolder::finish() const {
+  namespace fs = std::filesystem;
+  std::vector<std::string> files, dirs, ours_f, ours_d;
+  list_tree(dir_, keep_, files, dirs);
+  for (const auto& f : files) {
+    std::error_code ec;
+    const auto t = fs::last_write_time(dir_ / f, ec);
+    if (!listed(before_files_, f) || (!ec && t >= start_)) ours_f.push_back(f);
+  }
+  for (const auto& d : dirs)
+    if (!listed(before_dirs_, d)) ours_d.push_back(d);
+  std::vector<std::string> still_before;
+  for (const auto& f : before_files_)
+    if (!listed(ours_f, f)) still_before.push_back(f);
+  const nlohmann::json m = {{"complete", true},
+                            {"files", ours_f},
+                            {"dirs", ours_d},
+                            {"before_files", still_before},
+                            {"before_dirs", before_dirs_}};
+  write_file_atomically(dir_ / kManifest, m.dump(1) + "\n");
 }
 
 }  // namespace ncfsim::workflow

@@ -23,6 +23,28 @@ std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out
 /// (fem/io/atomic_file.hpp).
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 
+/// An output folder that ncfsim owns only in part: `.ncfsim_manifest.json` lists what ncfsim
+/// wrote there, so a rerun removes exactly that and never a file of the user's. Life cycle:
+/// claim() before the first file is written, finish() once the run has written its last.
+/// A run that dies in between leaves a manifest marked incomplete with the files that were there
+/// before it; the next claim() removes everything else.
+class OutputFolder {
+ public:
+  /// Creates dir or clears what an earlier run of ncfsim wrote there. A non-empty folder without
+  /// a manifest is refused (InputError naming the folder and a file in it) unless `overwrite`;
+  /// entries named in `keep` (a workflow's stage folders) are neither removed nor counted.
+  static OutputFolder claim(const std::filesystem::path& dir, bool overwrite,
+                            const std::vector<std::string>& keep = {});
+  /// Rewrites the manifest with every file and folder written since claim().
+  void finish() const;
+  const std::filesystem::path& dir() const { return dir_; }
+
+ private:
+  std::filesystem::path dir_;
+  std::vector<std::string> before_files_, before_dirs_, keep_;
+  std::filesystem::file_time_type start_;
+};
+
 /// history.csv: a header with named columns (units in the names), then one row per output time.
 /// Each row is flushed, so an interrupted run leaves only complete rows.
 class HistoryWriter {

@@ -39,14 +39,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-void clean_previous_results(const std::filesystem::path& dir) {
-  for (const char* f : {"results.h5", "results.xdmf", "results.pvd", "history.csv", "summary.json",
-                        "report.html", "figures.json", "case.toml", "log.txt"})
-    std::filesystem::remove(dir / f);
-  std::filesystem::remove_all(dir / "frames");
-  std::filesystem::remove_all(dir / "figures");
-}
-
 // results.h5/.xdmf and .vtu frames; a frame that cannot be written is logged, the run goes on.
 class FrameOutput {
  public:
@@ -324,8 +316,7 @@ std::filesystem::path output_folder(const std::string& case_name, const RunOptio
 
 int run_engine_case(EngineCase& ec, const RunOptions& options) {
   Run r(ec, options);
-  std::filesystem::create_directories(r.dir);
-  clean_previous_results(r.dir);
+  const OutputFolder folder = OutputFolder::claim(r.dir, options.overwrite);
   r.log = make_run_logger(r.dir, options.verbosity);
   std::filesystem::copy_file(ec.file, r.dir / "case.toml",
                              std::filesystem::copy_options::overwrite_existing);
@@ -367,6 +358,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   log_end(r, solver);
   draw_figures_and_report(r);
   r.log->info("results in {} (status: {})", r.dir.string(), r.status);
+  folder.finish();
   return exit_code;
 }
 

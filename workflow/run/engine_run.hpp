@@ -17,6 +17,7 @@ struct RunOptions {
   std::vector<std::string> overrides; // --set items, echoed into summary.json
   int ranks = 1;                      // --np: MPI ranks requested
   std::vector<std::string> force_stages;  // --force: workflow stages rerun although unchanged
+  bool overwrite = false;  // --overwrite: write into a folder holding files ncfsim did not write
 };
 
 /// Exit codes of the command line (docs/cli.md).

@@ -35,7 +35,7 @@ int run_kinematic_drape_stage(const StageCall& call) {
   const auto kc = drape::load_kinematic_drape_case(call.case_file, call.overrides);
   const auto t0 = std::chrono::steady_clock::now();
   const std::filesystem::path dir = output_folder(kc.name, call.options);
-  std::filesystem::create_directories(dir);
+  const OutputFolder folder = OutputFolder::claim(dir, call.options.overwrite);
   auto log = make_run_logger(dir, call.options.verbosity);
   log->info("ncfsim {} | case '{}' ({}) | kinematic drape", kVersion, kc.name,
             call.case_file.string());
@@ -80,6 +80,7 @@ int run_kinematic_drape_stage(const StageCall& call) {
   s["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_file_atomically(dir / "summary.json", s.dump(2) + "\n");
   log->info("wrote {}", (dir / "summary.json").string());
+  folder.finish();
   return missed == ring.size() ? kNumericalFailure : kSuccess;
 }
 

@@ -222,7 +222,7 @@ int run_transfer_stage(const StageCall& call) {
   const ImpregnatedModel m = build(tc, frame);
 
   const std::filesystem::path dir = output_folder(tc.name, call.options);
-  std::filesystem::create_directories(dir);
+  const OutputFolder folder = OutputFolder::claim(dir, call.options.overwrite);
   auto log = make_run_logger(dir, call.options.verbosity);
   log->info("ncfsim {} | case '{}' ({}) | transfer", kVersion, tc.name, call.case_file.string());
   if (!tc.description.empty()) log->info("  {}", tc.description);
@@ -286,6 +286,7 @@ int run_transfer_stage(const StageCall& call) {
     log->warn("report not written: {}", e.what());
   }
   log->info("results in {}", dir.string());
+  folder.finish();
   return kSuccess;
 }
 

@@ -186,7 +186,9 @@ int run_workflow_stage(const StageCall& call) {
   // has finalised it (the stages' sessions nest in this one).
   fem::PetscSession petsc;
   if (const int rc = refuse_many_ranks()) return rc;
-  fs::create_directories(out);
+  std::vector<std::string> stage_dirs;
+  for (const auto& p : plans) stage_dirs.push_back(p.spec.name);
+  const OutputFolder folder = OutputFolder::claim(out, call.options.overwrite, stage_dirs);
   auto log = make_run_logger(out, call.options.verbosity);
   StopRequest::install();
   const auto t0 = std::chrono::steady_clock::now();
@@ -316,6 +318,7 @@ int run_workflow_stage(const StageCall& call) {
   } else {
     log->info("workflow '{}' completed in {}: {}", wc.name, hms(wall()), out.string());
   }
+  folder.finish();
   return code;
 }
 
