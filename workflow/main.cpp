@@ -20,6 +20,7 @@
 #include "workflow/figures/figures.hpp"
 #include "workflow/report/report.hpp"
 #include "workflow/run/engine_run.hpp"
+#include "workflow/run/run_output.hpp"
 #include "workflow/stages/stage_registry.hpp"
 #include "workflow/stages/transfer_export.hpp"
 #include "workflow/stages/workflow_stage.hpp"
@@ -42,6 +43,7 @@ void require_output_folder(const std::filesystem::path& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  wf::StopRequest::install();  // before anything: a signal at any time ends the run cleanly
   CLI::App app{
       "ncfsim: meso-mechanical drape-to-failure simulation of stitched carbon fabric "
       "(explicit finite elements)"};

@@ -349,14 +349,26 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     r.log->error("{}", r.failure);
     exit_code = kNumericalFailure;
   }
-  if (exit_code == kSuccess && r.status == "interrupted") exit_code = kOtherError;
+  if (exit_code == kSuccess && (r.status == "interrupted" || r.status == "max_cycles"))
+    exit_code = kOtherError;  // docs/cli.md: results valid, the run did not reach its end
   fill_summary(r, solver, measures, history, frames);
   r.write_summary();
   for (const auto& m : measures)
     for (const auto& f : m->write_files(solver, r.dir))
       r.log->info("wrote {}", (r.dir / f).string());
   log_end(r, solver);
-  draw_figures_and_report(r);
+  if (!StopRequest::requested()) draw_figures_and_report(r);
+  if (StopRequest::requested() && r.status == "completed") {
+    // Ctrl-C after the last cycle: the results are complete, the figures are not all drawn.
+    r.status = "interrupted";
+    r.summary["figures_complete"] = false;
+    r.write_summary();
+    r.log->warn(
+        "interrupted after the last cycle: results complete, figures and report not all "
+        "drawn (ncfsim render {} draws them)",
+        r.dir.string());
+    if (exit_code == kSuccess) exit_code = kOtherError;
+  }
   r.log->info("results in {} (status: {})", r.dir.string(), r.status);
   folder.finish();
   return exit_code;

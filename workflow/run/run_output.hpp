@@ -5,8 +5,9 @@
 
 namespace ncfsim::workflow {
 
-/// SIGINT handling for long runs: the first Ctrl-C asks the run to stop after the current cycle,
-/// a second one terminates the process at once.
+/// Signal handling for long runs: the first SIGINT, SIGTERM, SIGHUP or SIGQUIT asks the run to stop
+/// after the current cycle (or stage step), a second one terminates the process at once; SIGPIPE
+/// is ignored. Installed first thing in main(), so a signal at any time leaves consistent files.
 class StopRequest {
  public:
   static void install();

@@ -1,0 +1,99 @@
+// Every way a run ends, against docs/cli.md's table of exit codes and statuses:
+//  * stopped by time.max_cycles: exit 1, status max_cycles (results valid, end not reached);
+//  * SIGTERM, SIGHUP, SIGQUIT mid-run end like Ctrl-C: exit 1, status interrupted, summary.json
+//    and results readable; so does a signal 0.3 s after the start (before, the run left no
+//    output folder);
+//  * a closed stdout (ncfsim run ... | head -1) does not kill the run: it completes, exit 0, and
+//    log.txt keeps every line.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "tests/workflow/cli_test_support.hpp"
+
+namespace ncfsim::test {
+namespace {
+
+const fs::path kCube = kSource / "tests/cases/erosion/crushed_cube.toml";
+const fs::path kCantilever = kSource / "cases/verification/cantilever.toml";
+
+nlohmann::json summary(const fs::path& out) {
+  return nlohmann::json::parse(slurp(out / "summary.json"));
+}
+
+std::vector<std::string> long_run(const fs::path& out) {
+  return {"run",   kCantilever.string(),  "-o",    out.string(),
+          "--set", "time.end_time=100.0", "--set", "output.figures=false",
+          "--set", "output.report=false"};
+}
+
+TEST(CliExitPaths, CycleLimitExitsOne) {
+  const fs::path out = fresh_dir("exit_max_cycles");
+  const auto r =
+      run_cli({"-q", "run", kCube.string(), "-o", out.string(), "--set", "time.max_cycles=10"});
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(summary(out)["status"], "max_cycles");
+}
+
+TEST(CliExitPaths, TerminationSignalsEndLikeCtrlC) {
+  for (int sig : {SIGTERM, SIGHUP, SIGQUIT}) {
+    const fs::path out = fresh_dir("exit_signal_" + std::to_string(sig));
+    const fs::path log = out.string() + ".log";
+    const pid_t pid = spawn(long_run(out), log);
+    bool running = false;
+    for (int i = 0; i < 600 && !running; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      try {
+        running = fs::exists(out / "summary.json") && summary(out)["status"] == "running";
+      } catch (const std::exception&) {
+      }
+    }
+    ASSERT_TRUE(running) << slurp(log);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    kill(pid, sig);
+    EXPECT_EQ(wait_code(pid), 1) << "signal " << sig << ": " << slurp(log);
+    EXPECT_EQ(summary(out)["status"], "interrupted") << "signal " << sig;
+  }
+}
+
+TEST(CliExitPaths, SignalRightAfterTheStartLeavesAnInterruptedRun) {
+  const fs::path out = fresh_dir("exit_early_signal");
+  const fs::path log = out.string() + ".log";
+  const pid_t pid = spawn(long_run(out), log);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  kill(pid, SIGTERM);
+  EXPECT_EQ(wait_code(pid), 1) << slurp(log);
+  ASSERT_TRUE(fs::exists(out / "summary.json")) << slurp(log);
+  EXPECT_EQ(summary(out)["status"], "interrupted");
+}
+
+TEST(CliExitPaths, ClosedStdoutDoesNotKillTheRun) {
+  const fs::path out = fresh_dir("exit_closed_pipe");
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    dup2(fds[1], 1);
+    dup2(fds[1], 2);
+    ::unsetenv("DISPLAY");
+    std::vector<std::string> args = {
+        kExe.string(), "run", kCube.string(), "-o", out.string(), "--progress-interval", "0.001"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  close(fds[1]);
+  close(fds[0]);  // nobody reads: the run's first write to stdout meets a closed pipe
+  EXPECT_EQ(wait_code(pid), 0);
+  EXPECT_EQ(summary(out)["status"], "completed");
+  EXPECT_NE(slurp(out / "log.txt").find("results in"), std::string::npos)
+      << "log.txt keeps the lines the console lost";
+}
+
+}  // namespace
+}  // namespace ncfsim::test
