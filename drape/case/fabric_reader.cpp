@@ -4,6 +4,7 @@
 
 #include "drape/case/drape_case.hpp"
 #include "drape/tow_material.hpp"
+#include "fem/case/model_size.hpp"
 #include "fem/errors.hpp"
 
 namespace ncfsim::drape {
@@ -12,7 +13,8 @@ using fem::TableReader;
 
 namespace {
 
-std::unique_ptr<fem::SolidMaterial> read_tow_biphase(const TableReader& t, const std::string& name, double rho) {
+std::unique_ptr<fem::SolidMaterial> read_tow_biphase(const TableReader& t, const std::string& name,
+                                                     double rho) {
   TowConstants c;
   c.density = rho;
   c.E11f = t.number("E11f", Range::non_negative());
@@ -30,8 +32,8 @@ std::unique_ptr<fem::SolidMaterial> read_tow_biphase(const TableReader& t, const
   c.locking_width_ratio = t.number("locking_width_ratio", 0.7, {0.0, 1.0, true, true});
   c.lock_stiffness_ratio = t.number("lock_stiffness_ratio", 50.0, Range::closed(1, 1e4));
   c.compaction_of_fibre_sheets =
-      t.choice("compaction_measure", {"transverse_strain", "fibre_sheet_spacing"}, "transverse_strain") ==
-      "fibre_sheet_spacing";
+      t.choice("compaction_measure", {"transverse_strain", "fibre_sheet_spacing"},
+               "transverse_strain") == "fibre_sheet_spacing";
   return std::make_unique<TowMaterial>(name, c);
 }
 
@@ -40,7 +42,8 @@ int read_int(const TableReader& t, std::string_view key, int fallback) {
 }
 
 // The fabric's own keys. Their ranges are checked once, by drape::validate (drape/fabric.cpp):
-// on the keys as given here, on the spec as meshed (the resolution's divisions) by generate_blanket.
+// on the keys as given here, on the spec as meshed (the resolution's divisions) by
+// generate_blanket.
 FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution) {
   FabricSpec f;
   if (fb.has("ply_angles_deg")) f.ply_angles_deg = fb.numbers("ply_angles_deg", {});
@@ -48,9 +51,12 @@ FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution
   f.tow_gap = fb.number("tow_gap", f.tow_gap, {});
   f.areal_weight = fb.number("areal_weight", f.areal_weight, {});
   f.fibre_density = fb.number("fibre_density", f.fibre_density, {});
-  f.tow_fibre_volume_fraction = fb.number("tow_fibre_volume_fraction", f.tow_fibre_volume_fraction, {});
+  f.tow_fibre_volume_fraction =
+      fb.number("tow_fibre_volume_fraction", f.tow_fibre_volume_fraction, {});
   const std::string stitch = fb.choice("stitch", {"tricot", "chain", "none"}, "tricot");
-  f.stitch = stitch == "tricot" ? StitchPattern::Tricot : stitch == "chain" ? StitchPattern::Chain : StitchPattern::None;
+  f.stitch = stitch == "tricot"  ? StitchPattern::Tricot
+             : stitch == "chain" ? StitchPattern::Chain
+                                 : StitchPattern::None;
   f.stitch_direction_deg = fb.number("stitch_direction_deg", 0.0, {});
   f.stitch_gauge = fb.number("stitch_gauge", 0.0, {});
   f.stitch_length = fb.number("stitch_length", 0.0, {});
@@ -72,8 +78,10 @@ void read_stitch_laws(const TableReader& fb, const FabricSpec& f, FabricEntry& f
   if (f.stitch == StitchPattern::None) {
     // A blank without stitch may keep its stitch keys (a control case made from a stitched one
     // by stitch = "none" alone): they are read and have no effect.
-    for (const char* k : {"stitch_law_I", "stitch_law_Lambda", "stitch_law_legs"}) (void)fb.string(k, "");
-    for (const char* k : {"connection_sliding_force", "connection_transverse_force", "connection_stiffness"})
+    for (const char* k : {"stitch_law_I", "stitch_law_Lambda", "stitch_law_legs"})
+      (void)fb.string(k, "");
+    for (const char* k :
+         {"connection_sliding_force", "connection_transverse_force", "connection_stiffness"})
       (void)fb.number(k, 0.0, {});
     return;
   }
@@ -81,8 +89,8 @@ void read_stitch_laws(const TableReader& fb, const FabricSpec& f, FabricEntry& f
   fe.law_Lambda = f.stitch == StitchPattern::Tricot ? fb.string("stitch_law_Lambda") : fe.law_I;
   fe.law_legs = fb.string("stitch_law_legs", fe.law_I);
   fe.connection.sliding_force = fb.number("connection_sliding_force", 0.05, Range::positive());
-  fe.connection.transverse_force =
-      fb.number("connection_transverse_force", 3 * fe.connection.sliding_force, Range::non_negative());
+  fe.connection.transverse_force = fb.number(
+      "connection_transverse_force", 3 * fe.connection.sliding_force, Range::non_negative());
   fe.connection.stiffness = fb.number("connection_stiffness", 0.0, Range::non_negative());
 }
 
@@ -103,8 +111,24 @@ FabricEntry read_fabric(fem::CaseReadContext& ctx, const TableReader& fb) {
   fe.angles = f.ply_angles_deg;
   fe.elements_through_thickness = f.elements_through_thickness;
   if (fe.name.empty() || fe.name.find_first_of(" ./\\") != std::string::npos)
-    fb.fail("name", "must be a non-empty name without spaces, dots or slashes (it prefixes the part names)");
+    fb.fail(
+        "name",
+        "must be a non-empty name without spaces, dots or slashes (it prefixes the part names)");
   fem::Mesh& mesh = ctx.model.mesh;
+  {  // before meshing: a blanket too fine or too large for the machine is bad input
+    const double pitch = f.tow_pitch(), el = f.element_length > 0 ? f.element_length : pitch;
+    const double ac = f.elements_across_tow, tt = f.elements_through_thickness;
+    const double area = bl.size[0] * bl.size[1];
+    const double n_hex =
+        static_cast<double>(f.ply_angles_deg.size()) * tt * ac * area / (pitch * el);
+    const double n_nodes = n_hex * (ac + 1) * (tt + 1) / (ac * tt);
+    const double n_stitch = f.stitch == StitchPattern::None ? 0.0 : 10.0 * area / (pitch * pitch);
+    fem::require_model_fits(
+        fb.file().string(), fb.key_path("size") + ", " + fb.key_path("element_length"),
+        static_cast<double>(mesh.n_nodes()) + n_nodes,
+        static_cast<double>(mesh.elements(fem::ElementKind::Hex8).size()) + n_hex,
+        static_cast<double>(mesh.elements(fem::ElementKind::Bar2).size()) + n_stitch);
+  }
   try {
     fe.model = generate_blanket(mesh, f, bl, ctx.file, fe.name + "_", fe.path);
   } catch (const InputError& e) {
@@ -127,11 +151,14 @@ FabricEntry read_fabric(fem::CaseReadContext& ctx, const TableReader& fb) {
   return fe;
 }
 
-int named_index(const fem::CaseReadContext& ctx, const FabricEntry& fe, const std::map<std::string, int>& names,
-                const std::string& n, const std::string& key) {
+int named_index(const fem::CaseReadContext& ctx, const FabricEntry& fe,
+                const std::map<std::string, int>& names, const std::string& n,
+                const std::string& key) {
   if (!names.count(n))
     throw InputError(ctx.file, fe.path + "." + key,
-                     "no such " + std::string(key == "tow_material" ? "[[material]]" : "[[bar_law]]") + " '" + n + "'");
+                     "no such " +
+                         std::string(key == "tow_material" ? "[[material]]" : "[[bar_law]]") +
+                         " '" + n + "'");
   return names.at(n);
 }
 
@@ -140,7 +167,8 @@ void assign_ply_parts(fem::CaseReadContext& ctx, const FabricEntry& fe) {
   // E11f_axial leaves bending to E11f through the hourglass moduli, which carry all of the
   // bending only with one hexahedron through the tow: with more, the layers' stretch (E11f_axial)
   // would bend it.
-  const auto* tow_law = dynamic_cast<const TowMaterial*>(ctx.model.materials[static_cast<std::size_t>(tow)].get());
+  const auto* tow_law =
+      dynamic_cast<const TowMaterial*>(ctx.model.materials[static_cast<std::size_t>(tow)].get());
   if (tow_law && tow_law->constants().E11f_axial > 0 && fe.elements_through_thickness > 1)
     throw InputError(ctx.file, fe.path + ".elements_through_thickness",
                      "must be 1 with tow material '" + fe.tow_material +
@@ -158,13 +186,16 @@ void assign_ply_parts(fem::CaseReadContext& ctx, const FabricEntry& fe) {
 }
 
 void assign_stitch_parts(fem::CaseReadContext& ctx, const FabricEntry& fe) {
-  const std::pair<int, std::string> bar_parts[] = {
-      {fe.model.stitch_I_part, fe.law_I}, {fe.model.stitch_Lambda_part, fe.law_Lambda}, {fe.model.stitch_leg_part, fe.law_legs}};
+  const std::pair<int, std::string> bar_parts[] = {{fe.model.stitch_I_part, fe.law_I},
+                                                   {fe.model.stitch_Lambda_part, fe.law_Lambda},
+                                                   {fe.model.stitch_leg_part, fe.law_legs}};
   for (const auto& [p, law] : bar_parts) {
     if (p < 0) continue;
     auto& pp = ctx.model.parts[static_cast<std::size_t>(p)];
     pp.bar_law = named_index(ctx, fe, ctx.bar_laws, law,
-                             law == fe.law_I ? "stitch_law_I" : law == fe.law_Lambda ? "stitch_law_Lambda" : "stitch_law_legs");
+                             law == fe.law_I        ? "stitch_law_I"
+                             : law == fe.law_Lambda ? "stitch_law_Lambda"
+                                                    : "stitch_law_legs");
     ctx.part_defined[static_cast<std::size_t>(p)] = 1;
   }
 }
@@ -195,7 +226,8 @@ void renumber_fabrics(fem::CaseReadContext& ctx, std::vector<FabricEntry>& fabri
   }
 }
 
-std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx, const std::vector<FabricEntry>& fabrics) {
+std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx,
+                                               const std::vector<FabricEntry>& fabrics) {
   std::vector<FabricSummary> summaries;
   for (const auto& fe : fabrics) {
     assign_ply_parts(ctx, fe);
@@ -203,8 +235,8 @@ std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx, const 
     int connection_contact = -1;
     if (!fe.model.connections.empty()) {
       connection_contact = static_cast<int>(ctx.model.contacts.size());
-      ctx.model.contacts.push_back(
-          std::make_unique<StitchToTowConnection>(fe.name + "_stitch_tow", fe.model.connections, fe.connection));
+      ctx.model.contacts.push_back(std::make_unique<StitchToTowConnection>(
+          fe.name + "_stitch_tow", fe.model.connections, fe.connection));
     }
     summaries.push_back({fe.name, fe.model.n_tows, fe.model.n_dropped_tows, fe.model.n_penetrations,
                          fe.model.connections.size(), fe.model.tow_thickness, connection_contact,

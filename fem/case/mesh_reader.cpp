@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "fem/case/fem_case.hpp"
+#include "fem/case/model_size.hpp"
 #include "fem/mesh.hpp"
 
 namespace ncfsim::fem {
@@ -46,6 +47,12 @@ void read_block(CaseReadContext& ctx, const TableReader& b) {
     if (d != std::floor(d)) b.fail("divisions", "must be integers");
     div[k] = d == 1 ? 1 : std::max(1, static_cast<int>(std::lround(d * ctx.resolution_factor)));
   }
+  const Mesh& m = ctx.model.mesh;
+  require_model_fits(
+      b.file().string(), b.key_path("divisions"),
+      static_cast<double>(m.n_nodes()) + (div[0] + 1.0) * (div[1] + 1.0) * (div[2] + 1.0),
+      static_cast<double>(m.elements(ElementKind::Hex8).size()) + 1.0 * div[0] * div[1] * div[2],
+      static_cast<double>(m.elements(ElementKind::Bar2).size()));
   const int p = use_part(ctx, b, part, PartKind::Solid);
   add_hex_block(ctx.model.mesh, p, origin, size, div);
 }
@@ -55,6 +62,11 @@ void read_line(CaseReadContext& ctx, const TableReader& l) {
   const auto a = l.vec3("start"), bnd = l.vec3("end");
   const int nd = static_cast<int>(l.integer("divisions", 1, 1000000));
   const int n_div = std::max(1, static_cast<int>(std::lround(nd * ctx.resolution_factor)));
+  require_model_fits(
+      l.file().string(), l.key_path("divisions"),
+      static_cast<double>(ctx.model.mesh.n_nodes()) + n_div + 1.0,
+      static_cast<double>(ctx.model.mesh.elements(ElementKind::Hex8).size()),
+      static_cast<double>(ctx.model.mesh.elements(ElementKind::Bar2).size()) + n_div);
   const int p = use_part(ctx, l, part, PartKind::Bar);
   Mesh& mesh = ctx.model.mesh;
   const auto first = static_cast<std::int32_t>(mesh.n_nodes());

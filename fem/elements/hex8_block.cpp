@@ -211,6 +211,7 @@ void hex8_initialise(Hex8Block& b, const double* x_ref, const std::array<double,
   b.strain.assign(6 * n, 0.0);
   b.history.assign(static_cast<std::size_t>(b.material->n_history()) * n, 0.0);
   b.hg_force.assign(12 * n, 0.0);
+  b.hg_viscous.assign(12 * n, 0.0);
   b.mat_axes.assign(9 * n, 0.0);
   b.jac_inv0.assign(9 * n, 0.0);
   b.jac_inv0_axes.assign(9 * n, 0.0);
@@ -383,6 +384,7 @@ void hex8_element_force(const Hex8Block& b, std::size_t e, const double* x, cons
   take(b.strain, one.strain);
   take(b.history, one.history);
   take(b.hg_force, one.hg_force);
+  take(b.hg_viscous, one.hg_viscous);
   take(b.mat_axes, one.mat_axes);
   take(b.jac_inv0, one.jac_inv0);
   take(b.jac_inv0_axes, one.jac_inv0_axes);
@@ -413,7 +415,7 @@ double hex8_erode(Hex8Block& b, std::size_t e) {
   double w = 0;
   for (int c = 0; c < 6; ++c) w += b.stress[c * n + e] * b.strain[c * n + e];
   for (int c = 0; c < 6; ++c) b.stress[c * n + e] = 0.0, b.strain[c * n + e] = 0.0;
-  for (int k = 0; k < 12; ++k) b.hg_force[k * n + e] = 0.0;
+  for (int k = 0; k < 12; ++k) b.hg_force[k * n + e] = 0.0, b.hg_viscous[k * n + e] = 0.0;
   return 0.5 * w * b.volume0[e];
 }
 
@@ -514,6 +516,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
   double* strain = b.strain.data();
   double* stress = b.stress.data();
   double* hgf = b.hg_force.data();
+  double* hgv = b.hg_viscous.data();
 
   // The element state is ~50 separate [component][n] streams, more than the hardware prefetchers
   // follow: every stream of the chunk kAhead chunks ahead is requested (into L2) while this one
@@ -538,6 +541,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
     rows(strain, 6, write);
     rows(stress, 6, write);
     rows(hgf, 12, write);
+    if (zeta != 0) rows(hgv, 12, write);
     rows(b.volume.data(), 1, write);
   };
   constexpr std::size_t kAhead = 4;  // chunks
@@ -772,8 +776,13 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         const VD qn = qo + dQ[k];
         store(hgf + k * n + e, qn, cnt);
         wst += 0.5 * (qo + qn) * dc[k];
+        // Trapezoid over the increments around each force, as every other work is booked: the
+        // increment before t^n carries half of this force and half of the last cycle's.
         const VD qv = cv * qd[k];
-        whg += qv * dc[k];
+        if (zeta != 0) {
+          whg += 0.5 * (qv + load(hgv + k * n + e, cnt)) * dc[k];
+          store(hgv + k * n + e, qv, cnt);
+        }
         Qt[k] = qn + qv;
       }
       e_stab += live(wst);

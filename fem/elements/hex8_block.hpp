@@ -35,6 +35,8 @@ struct Hex8Block {
   std::vector<double> history;  // [n_history][n]
   std::vector<double>
       hg_force;  // [12][n] hourglass generalised forces, element frame, [3*mode+axis]
+  std::vector<double> hg_viscous;  // [12][n] viscous hourglass forces of the last cycle (their
+                                   // work is booked over both increments around it)
   std::vector<double>
       mat_axes;  // [9][n] reference material axes, global (row-major, axes = columns)
   std::vector<double> jac_inv0;        // [9][n] inverse of the reference centre Jacobian

@@ -97,3 +97,34 @@ TEST(CliExitPaths, ClosedStdoutDoesNotKillTheRun) {
 
 }  // namespace
 }  // namespace ncfsim::test
+
+namespace ncfsim::test {
+namespace {
+
+// A model too large for the machine is bad input naming the key that sizes it, before anything
+// is allocated (it was std::bad_alloc, exit 1, or the kernel's OOM killer).
+TEST(CliExitPaths, ModelTooLargeForTheMachineIsBadInput) {
+  const fs::path out = fresh_dir("exit_too_large");
+  struct Big {
+    std::string file, set, key;
+  };
+  for (const Big& b :
+       std::vector<Big>{{"tests/cases/erosion/crushed_cube.toml",
+                         "mesh.block[0].divisions=[1000,1000,1000]", "mesh.block[0].divisions"},
+                        {"cases/drape/bias_extension_positive.toml",
+                         "mesh.fabric[0].element_length=1e-9", "mesh.fabric[0].element_length"},
+                        {"cases/drape/bias_extension_positive.toml",
+                         "mesh.fabric[0].size=[1e5,1e5]", "mesh.fabric[0].size"}}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r =
+        run_cli({"run", (kSource / b.file).string(), "-o", out.string(), "--set", b.set});
+    EXPECT_EQ(r.code, 2) << b.set << ": " << r.output;
+    EXPECT_NE(r.output.find(b.key), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("too large for this machine"), std::string::npos) << r.output;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10.0);
+    EXPECT_FALSE(fs::exists(out)) << "refused before the output folder is made";
+  }
+}
+
+}  // namespace
+}  // namespace ncfsim::test

@@ -1,0 +1,25 @@
+#pragma once
+// Is a model small enough for this machine? Estimated from the counts a case asks for, before the
+// mesh is generated: a block of 1000^3 hexahedra or a fabric meshed at 1e-9 m is bad input naming
+// its key, not a std::bad_alloc (or the kernel's OOM killer) minutes later.
+#include <string>
+
+namespace ncfsim::fem {
+
+/// Bytes an explicit model holds (nodal state vectors, element state, contact surfaces), per
+/// node, hexahedron and bar: an upper estimate from the engine's arrays (docs/case-file.md).
+double estimated_model_bytes(double n_nodes, double n_hex, double n_bars);
+
+/// Memory available to this process now (MemAvailable of /proc/meminfo; the physical memory when
+/// that cannot be read), bytes.
+double available_memory_bytes();
+
+/// Throws InputError(file, key) when a model of the counts given (the whole model so far plus
+/// what `key` adds) would need more than 80 % of the memory available, naming the estimate.
+void require_model_fits(const std::string& file, const std::string& key, double n_nodes,
+                        double n_hex, double n_bars);
+
+/// "1.2 GB", "350 MB".
+std::string bytes_text(double bytes);
+
+}  // namespace ncfsim::fem

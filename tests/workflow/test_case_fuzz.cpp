@@ -1,0 +1,225 @@
+// Fuzzed case files through `ncfsim check` (issue #23): every case file under cases/ and
+// tests/cases/ (copied with their folders, so relative paths still resolve) is mutated
+// deterministically, key by key (deleted; set to 0, -1, nan, inf, 1e30, a huge count, a string of
+// garbage, an empty array, true) and as a whole (truncated, garbage bytes inserted, emptied);
+// at least 2000 variants. Each is checked under a 6 GB address-space limit and a 120 s time
+// limit and must end with exit code 0 (still a valid case) or 2 (bad input naming the key):
+// never a crash, a signal, an out-of-memory exit (1) or a hang. The variants that fail are listed
+// with their mutation and the output, and kept under the test's folder to rerun by hand.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <thread>
+
+#include "tests/workflow/cli_test_support.hpp"
+
+namespace ncfsim::test {
+namespace {
+
+constexpr std::size_t kLeavesPerFile = 6;  // keys mutated per file (spread over the file)
+constexpr int kParallel = 2;
+constexpr double kTimeLimit = 120;            // s per variant
+constexpr rlim_t kAddressLimit = 6ull << 30;  // bytes
+
+struct Variant {
+  fs::path file;
+  std::string what;  // the mutation, for the report
+};
+
+// Key paths of the leaves of a TOML tree (arrays of tables are descended; plain arrays are leaves).
+void leaves(const toml::node& n, std::vector<toml::path>& out, const toml::path& here) {
+  if (const auto* t = n.as_table()) {
+    for (const auto& [k, v] : *t) leaves(v, out, here + toml::path(std::string(k.str())));
+  } else if (const auto* a = n.as_array(); a && a->is_array_of_tables()) {
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      std::string index = std::to_string(i);  // "[" + ... trips GCC 12's -Wrestrict
+      index.insert(index.begin(), '[');
+      index.push_back(']');
+      leaves(*a->get(i), out, here + toml::path(index));
+    }
+  } else {
+    out.push_back(here);
+  }
+}
+
+// The parent table (or array) of a leaf and its last component.
+bool mutate_leaf(toml::table& root, const toml::path& p, int kind) {
+  toml::node* parent = p.parent().empty() ? &root : root.at_path(p.parent()).node();
+  if (!parent) return false;
+  const auto& last = p[p.size() - 1];
+  auto value = [&]() -> std::unique_ptr<toml::node> {
+    switch (kind) {
+      case 1:
+        return std::make_unique<toml::value<std::int64_t>>(0);
+      case 2:
+        return std::make_unique<toml::value<std::int64_t>>(-1);
+      case 3:
+        return std::make_unique<toml::value<double>>(std::numeric_limits<double>::quiet_NaN());
+      case 4:
+        return std::make_unique<toml::value<double>>(std::numeric_limits<double>::infinity());
+      case 5:
+        return std::make_unique<toml::value<double>>(1e30);
+      case 6:
+        return std::make_unique<toml::value<std::int64_t>>(2000000000);
+      case 7:
+        return std::make_unique<toml::value<std::string>>("\x01garbage\xff");
+      case 8:
+        return std::make_unique<toml::array>();
+      default:
+        return std::make_unique<toml::value<bool>>(true);
+    }
+  };
+  if (auto* t = parent->as_table(); t && last.type() == toml::path_component_type::key) {
+    if (kind == 0) return t->erase(last.key()) > 0;
+    auto v = value();
+    t->insert_or_assign(last.key(), std::move(*v));
+    return true;
+  }
+  if (auto* a = parent->as_array(); a && last.type() == toml::path_component_type::array_index) {
+    if (last.index() >= a->size()) return false;
+    a->erase(a->begin() + static_cast<std::ptrdiff_t>(last.index()));
+    if (kind != 0) {
+      auto v = value();
+      a->insert(a->begin() + static_cast<std::ptrdiff_t>(last.index()), std::move(*v));
+    }
+    return true;
+  }
+  return false;
+}
+
+const char* kKindNames[] = {"deleted",        "0",  "-1",  "nan", "inf", "1e30", "2e9",
+                            "garbage string", "[]", "true"};
+
+std::vector<Variant> make_variants(const fs::path& root, const std::vector<fs::path>& cases) {
+  std::vector<Variant> out;
+  std::size_t serial = 0;
+  for (const auto& file : cases) {
+    const std::string text = slurp(file);
+    auto name = [&](const std::string& tag) {
+      return file.parent_path() / ("fuzz_" + std::to_string(serial++) + "_" + tag + ".toml");
+    };
+    auto write = [&](const fs::path& p, const std::string& t, std::string what) {
+      std::ofstream(p, std::ios::binary) << t;
+      out.push_back({p, fs::relative(file, root).string() + ": " + what});
+    };
+    write(name("truncated"), text.substr(0, text.size() / 2), "truncated at half");
+    std::string garbled = text;
+    static const std::string junk("\x00\xfe\x01]]]=[[\"\n", 10);
+    garbled.insert(garbled.size() / 3, junk);
+    write(name("garbled"), garbled, "garbage bytes at a third");
+    write(name("empty"), "", "emptied");
+    toml::table doc;
+    try {
+      doc = toml::parse(text);
+    } catch (const toml::parse_error&) {
+      continue;
+    }
+    std::vector<toml::path> paths;
+    leaves(doc, paths, toml::path());
+    const std::size_t n = std::min(kLeavesPerFile, paths.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      const toml::path& p = paths[i * paths.size() / n];
+      for (int kind = 0; kind < 10; ++kind) {
+        toml::table copy = doc;
+        if (!mutate_leaf(copy, p, kind)) continue;
+        std::ostringstream os;
+        os << copy;
+        write(name("key"), os.str(), std::string(p.str()) + " " + kKindNames[kind]);
+      }
+    }
+  }
+  return out;
+}
+
+pid_t start_check(const fs::path& file, const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    rlimit as{kAddressLimit, kAddressLimit};
+    setrlimit(RLIMIT_AS, &as);
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    ::unsetenv("DISPLAY");
+    std::vector<std::string> args = {kExe.string(), "check", file.string()};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+TEST(CliFuzz, MutatedCaseFilesEndWithExitZeroOrTwo) {
+  const fs::path root = fresh_dir("case_fuzz");
+  fs::create_directories(root);
+  fs::copy(kSource / "cases", root / "cases", fs::copy_options::recursive);
+  fs::create_directories(root / "tests");
+  fs::copy(kSource / "tests/cases", root / "tests/cases", fs::copy_options::recursive);
+  std::vector<fs::path> cases;
+  for (const auto& e : fs::recursive_directory_iterator(root))
+    if (e.path().extension() == ".toml") cases.push_back(e.path());
+  std::sort(cases.begin(), cases.end());
+  const std::vector<Variant> variants = make_variants(root, cases);
+  ASSERT_GE(variants.size(), 2000u) << "from " << cases.size() << " case files";
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::map<int, std::size_t> by_code;
+  std::vector<std::string> failures;
+  struct Running {
+    pid_t pid;
+    std::size_t k;
+    std::chrono::steady_clock::time_point start;
+  };
+  std::vector<Running> running;
+  std::size_t next = 0;
+  auto log_of = [&](std::size_t k) { return fs::path(variants[k].file.string() + ".log"); };
+  while (next < variants.size() || !running.empty()) {
+    while (next < variants.size() && running.size() < static_cast<std::size_t>(kParallel)) {
+      running.push_back(
+          {start_check(variants[next].file, log_of(next)), next, std::chrono::steady_clock::now()});
+      ++next;
+    }
+    for (std::size_t r = 0; r < running.size();) {
+      int status = 0;
+      const pid_t done = waitpid(running[r].pid, &status, WNOHANG);
+      const double age =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - running[r].start)
+              .count();
+      if (done == 0 && age < kTimeLimit) {
+        ++r;
+        continue;
+      }
+      const std::size_t k = running[r].k;
+      int code;
+      if (done == 0) {
+        kill(running[r].pid, SIGKILL);
+        waitpid(running[r].pid, &status, 0);
+        code = -2;
+      } else {
+        code = exit_code(status);
+      }
+      ++by_code[code];
+      if (code != 0 && code != 2)
+        failures.push_back(
+            variants[k].what + " -> " +
+            (code == -2 ? std::string("timed out") : "exit " + std::to_string(code)) + " (" +
+            variants[k].file.string() + "): " + slurp(log_of(k)).substr(0, 400));
+      else
+        fs::remove(variants[k].file), fs::remove(log_of(k));
+      running.erase(running.begin() + static_cast<std::ptrdiff_t>(r));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("fuzz: %zu variants of %zu case files in %.0f s: %zu exit 0, %zu exit 2, %zu other\n",
+              variants.size(), cases.size(), wall, by_code[0], by_code[2], failures.size());
+  for (const auto& f : failures) ADD_FAILURE() << f;
+}
+
+}  // namespace
+}  // namespace ncfsim::test
