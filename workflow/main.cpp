@@ -228,12 +228,14 @@ int main(int argc, char** argv) {
       require_output_folder(folder);
       auto log = wf::make_run_logger({}, verbosity);
       const auto pngs = wf::render_figures(folder, *log);
+      wf::OutputFolder::record(folder, pngs);
       for (const auto& p : pngs) log->info("{}", p.string());
       return pngs.empty() ? wf::kOtherError : wf::kSuccess;
     }
     if (*exporter) {
       require_output_folder(folder);
       const auto r = wf::export_impregnated(folder, deck_format);
+      wf::OutputFolder::record(folder, {r.file});
       std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs\n", r.file.c_str(),
                   r.nodes, r.elements, r.materials, r.tie_pairs);
       return wf::kSuccess;
@@ -246,6 +248,7 @@ int main(int argc, char** argv) {
         wf::write_workflow_report(folder);
       else
         wf::write_report(folder);
+      wf::OutputFolder::record(folder, {std::filesystem::path(folder) / "report.html"});
       std::printf("%s\n", (std::filesystem::path(folder) / "report.html").c_str());
       return wf::kSuccess;
     }

@@ -204,4 +204,31 @@ void OutputFolder::finish() const {
   write_file_atomically(dir_ / kManifest, m.dump(1) + "\n");
 }
 
+void OutputFolder::record(const std::filesystem::path& dir,
+                          const std::vector<std::filesystem::path>& files) {
+  namespace fs = std::filesystem;
+  const fs::path manifest = dir / kManifest;
+  if (!fs::exists(manifest)) return;
+  nlohmann::json m;
+  try {
+    std::ifstream in(manifest);
+    m = nlohmann::json::parse(in);
+  } catch (const std::exception&) {
+    return;  // claim() reports an unreadable manifest on the next run
+  }
+  if (!m.value("complete", false)) return;
+  auto ours = m.value("files", std::vector<std::string>{});
+  auto before = m.value("before_files", std::vector<std::string>{});
+  for (const auto& f : files) {
+    const std::string rel = fs::relative(f, dir).generic_string();
+    if (rel.empty() || rel.rfind("..", 0) == 0) continue;
+    if (std::find(ours.begin(), ours.end(), rel) == ours.end()) ours.push_back(rel);
+    before.erase(std::remove(before.begin(), before.end(), rel), before.end());
+  }
+  std::sort(ours.begin(), ours.end());
+  m["files"] = ours;
+  m["before_files"] = before;
+  write_file_atomically(manifest, m.dump(1) + "\n");
+}
+
 }  // namespace ncfsim::workflow

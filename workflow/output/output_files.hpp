@@ -37,6 +37,10 @@ class OutputFolder {
                             const std::vector<std::string>& keep = {});
   /// Rewrites the manifest with every file and folder written since claim().
   void finish() const;
+  /// Adds files written into a finished run's folder later (`ncfsim render`, `report`,
+  /// `export`) to its manifest, so a rerun clears them too; no manifest: nothing to do.
+  static void record(const std::filesystem::path& dir,
+                     const std::vector<std::filesystem::path>& files);
   const std::filesystem::path& dir() const { return dir_; }
 
  private:

@@ -12,19 +12,7 @@ namespace ncfsim::workflow {
 
 namespace {
 
-std::string escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
-    }
-  }
-  return o;
-}
+std::string escape(const std::string& s) { return html_escape(s); }
 
 std::string read_text(const std::filesystem::path& p) {
   std::ifstream in(p);
@@ -53,17 +41,37 @@ double summary_number(const nlohmann::json& s, const char* key, double missing) 
 
 }  // namespace
 
+std::string html_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+std::string html_head(const std::string& title) {
+  return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" +
+         html_escape(title) +
+         "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
+         "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 8px;"
+         "text-align:left;font-size:90%}img{max-width:100%;border:1px solid #ddd;margin:6px 0}"
+         "pre{background:#f6f6f6;padding:8px;overflow-x:auto}.bad{color:#b00;font-weight:bold}"
+         ".ok{color:#070;font-weight:bold}</style></head><body>\n";
+}
+
 void write_report(const std::filesystem::path& dir) {
   std::ifstream in(dir / "summary.json");
   if (!in) throw std::runtime_error((dir / "summary.json").string() + " not found (is this a run's output folder?)");
   const nlohmann::json s = nlohmann::json::parse(in);
   const std::string name = s.value("case", "ncfsim run");
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape(name)
-    << " - ncfsim report</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
-       "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;font-size:90%}"
-       "img{max-width:100%;border:1px solid #ddd;margin:6px 0}pre{background:#f6f6f6;padding:8px;overflow-x:auto}"
-       ".bad{color:#b00;font-weight:bold}.ok{color:#070;font-weight:bold}</style></head><body>\n";
+  h << html_head(name + " - ncfsim report");
   h << "<h1>" << escape(name) << "</h1>\n";
   const std::string status = s.value("status", "unknown");
   const double err = summary_number(s, "energy_balance_error", 0.0);

@@ -18,6 +18,7 @@
 #include "fem/petsc_vector.hpp"
 #include "workflow/output/output_files.hpp"
 #include "workflow/render/render.hpp"
+#include "workflow/report/report.hpp"
 #include "workflow/run/run_output.hpp"
 #include "workflow/stages/workflow_case.hpp"
 #include "workflow/version.hpp"
@@ -355,28 +356,7 @@ int check_workflow_stage(const StageCall& call) {
 
 namespace {
 
-std::string escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        o += "&amp;";
-        break;
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += c;
-    }
-  }
-  return o;
-}
+std::string escape(const std::string& s) { return html_escape(s); }
 
 std::string number(const json& s, const std::string& key, const char* fmt_spec = "{:.4g}") {
   if (!s.is_object() || !s.contains(key) || !s[key].is_number()) return "-";
@@ -422,12 +402,7 @@ void write_workflow_report(const fs::path& dir) {
     throw std::runtime_error((dir / "summary.json").string() + " is not a workflow's summary");
   const std::string name = s.value("case", "workflow");
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape(name)
-    << " - ncfsim workflow</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:2em "
-       "auto;color:#222}table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid "
-       "#bbb;padding:3px 8px;text-align:left;font-size:90%}img{max-width:100%;border:1px solid "
-       "#ddd;margin:6px 0}.bad{color:#b00;font-weight:bold}.ok{color:#070;font-weight:bold}"
-       "</style></head><body>\n";
+  h << html_head(name + " - ncfsim workflow");
   const std::string status = s.value("status", "unknown");
   h << "<h1>" << escape(name) << "</h1>\n<p>ncfsim " << escape(s.value("ncfsim_version", "?"))
     << " &middot; workflow " << escape(s.value("case_file", ""))
