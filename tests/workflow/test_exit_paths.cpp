@@ -1,8 +1,8 @@
 // Every way a run ends, against docs/cli.md's table of exit codes and statuses:
 //  * stopped by time.max_cycles: exit 1, status max_cycles (results valid, end not reached);
 //  * SIGTERM, SIGHUP, SIGQUIT mid-run end like Ctrl-C: exit 1, status interrupted, summary.json
-//    and results readable; so does a signal 0.3 s after the start (before, the run left no
-//    output folder);
+//    and results readable; so does a signal the moment the handler is in place, before the case
+//    is read (before, a signal in the first 0.4 s left no output folder);
 //  * a closed stdout (ncfsim run ... | head -1) does not kill the run: it completes, exit 0, and
 //    log.txt keeps every line.
 #include <gtest/gtest.h>
@@ -58,11 +58,29 @@ TEST(CliExitPaths, TerminationSignalsEndLikeCtrlC) {
   }
 }
 
+// Whether process pid catches signal sig yet (/proc/<pid>/status, SigCgt).
+bool catches(pid_t pid, int sig) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("SigCgt:", 0) == 0) {
+      const unsigned long long mask = std::stoull(line.substr(7), nullptr, 16);
+      return (mask >> (sig - 1)) & 1u;
+    }
+  return false;
+}
+
 TEST(CliExitPaths, SignalRightAfterTheStartLeavesAnInterruptedRun) {
   const fs::path out = fresh_dir("exit_early_signal");
   const fs::path log = out.string() + ".log";
   const pid_t pid = spawn(long_run(out), log);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // The signal as soon as the handler is in place: before the case is read, before any output.
+  bool ready = false;
+  for (int i = 0; i < 20000 && !ready; ++i) {
+    ready = catches(pid, SIGTERM);
+    if (!ready) std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  ASSERT_TRUE(ready) << slurp(log);
   kill(pid, SIGTERM);
   EXPECT_EQ(wait_code(pid), 1) << slurp(log);
   ASSERT_TRUE(fs::exists(out / "summary.json")) << slurp(log);
