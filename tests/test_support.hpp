@@ -20,15 +20,17 @@ inline ::testing::AssertionResult near_rel(double a, double b, double rel, doubl
 }
 
 /// Nodes whose coordinate `axis` equals `value` within `tol`.
-inline std::vector<std::int32_t> nodes_at(const fem::Mesh& m, int axis, double value, double tol = 1e-9) {
+inline std::vector<std::int32_t> nodes_at(const fem::Mesh& m, int axis, double value,
+                                          double tol = 1e-9) {
   std::vector<std::int32_t> out;
   for (std::size_t i = 0; i < m.n_nodes(); ++i)
-    if (std::abs(m.coords[3 * i + axis] - value) <= tol) out.push_back(static_cast<std::int32_t>(i));
+    if (std::abs(m.coords[3 * i + axis] - value) <= tol)
+      out.push_back(static_cast<std::int32_t>(i));
   return out;
 }
 
-inline std::vector<std::int32_t> nodes_where(const fem::Mesh& m,
-                                             const std::function<bool(double, double, double)>& pred) {
+inline std::vector<std::int32_t> nodes_where(
+    const fem::Mesh& m, const std::function<bool(double, double, double)>& pred) {
   std::vector<std::int32_t> out;
   for (std::size_t i = 0; i < m.n_nodes(); ++i)
     if (pred(m.coords[3 * i], m.coords[3 * i + 1], m.coords[3 * i + 2]))
@@ -37,14 +39,37 @@ inline std::vector<std::int32_t> nodes_where(const fem::Mesh& m,
 }
 
 /// A model with one solid part made of a structured block, isotropic elastic.
-inline void add_elastic_block(fem::Model& model, const std::string& part, std::array<double, 3> origin,
-                              std::array<double, 3> size, std::array<int, 3> div, double rho,
-                              double E, double nu) {
+inline void add_elastic_block(fem::Model& model, const std::string& part,
+                              std::array<double, 3> origin, std::array<double, 3> size,
+                              std::array<int, 3> div, double rho, double E, double nu) {
   const int p = model.mesh.add_part(part);
   fem::add_hex_block(model.mesh, p, origin, size, div);
   model.materials.push_back(std::make_unique<fem::ElasticIsotropic>(part + "_mat", rho, E, nu));
-  if (static_cast<int>(model.parts.size()) <= p) model.parts.resize(static_cast<std::size_t>(p) + 1);
+  if (static_cast<int>(model.parts.size()) <= p)
+    model.parts.resize(static_cast<std::size_t>(p) + 1);
   model.parts[static_cast<std::size_t>(p)].material = static_cast<int>(model.materials.size()) - 1;
+}
+
+/// A fixed rigid plane through `point` (normal `axis`, the body on its side) touching `nodes`.
+inline fem::RigidTool& add_rigid_plane(fem::Model& model, const std::string& name, fem::V3 point,
+                                       fem::V3 axis, std::vector<std::int32_t> nodes,
+                                       double friction = 0.0) {
+  fem::RigidTool plane;
+  plane.name = name;
+  plane.surface.shape = fem::ToolShape::Plane;
+  plane.surface.point = point;
+  plane.surface.axis = axis;
+  plane.contact_nodes = std::move(nodes);
+  plane.friction = friction;
+  model.tools.push_back(std::move(plane));
+  return model.tools.back();
+}
+
+/// Every node of the mesh.
+inline std::vector<std::int32_t> all_nodes(const fem::Mesh& m) {
+  std::vector<std::int32_t> out(m.n_nodes());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<std::int32_t>(i);
+  return out;
 }
 
 inline double node_coord(const fem::ExplicitSolver& s, std::int32_t node, int c) {

@@ -11,15 +11,10 @@ TEST(EnergyBalance, RoundOffBeforeContactIsNotAnError) {
   fem::Model model;
   test::add_elastic_block(model, "block", {0, 0, 0.001}, {0.01, 0.01, 0.01}, {2, 2, 2}, 1000, 1e6,
                           0.3);
-  fem::RigidTool plane;
-  plane.name = "plane";
-  plane.surface.shape = fem::ToolShape::Plane;
-  plane.surface.point = {0, 0, 0};
-  plane.surface.axis = {0, 0, 1};
+  fem::RigidTool& plane = test::add_rigid_plane(model, "plane", {0, 0, 0}, {0, 0, 1},
+                                                test::nodes_at(model.mesh, 2, 0.001));
   plane.motion.kind = fem::ToolMotion::Kind::Velocity;
   plane.motion.velocity = {0, 0, 0.1};
-  plane.contact_nodes = test::nodes_at(model.mesh, 2, 0.001);
-  model.tools.push_back(plane);
   model.time.end_time = 0.02;
   fem::ExplicitSolver solver(model);
   double worst_before = 0, worst_after = 0, largest = 0;
@@ -48,16 +43,8 @@ TEST(EnergyBalance, ViscousHourglassWorkEqualsTheEnergyItTakesOut) {
   test::add_elastic_block(model, "block", {0, 0, 0.0005}, {0.02, 0.02, 0.02}, {2, 2, 2}, 1000, 1e6,
                           0.3);
   model.parts[0].hourglass_viscosity = 0.2;
-  fem::RigidTool wall;
-  wall.name = "wall";
-  wall.surface.shape = fem::ToolShape::Plane;
-  wall.surface.point = {0, 0, 0};
-  wall.surface.axis = {0, 0, 1};
-  wall.contact_nodes = test::nodes_at(model.mesh, 2, 0.0005);
-  model.tools.push_back(wall);
-  std::vector<std::int32_t> all;
-  for (std::int32_t i = 0; i < static_cast<std::int32_t>(model.mesh.n_nodes()); ++i)
-    all.push_back(i);
+  test::add_rigid_plane(model, "wall", {0, 0, 0}, {0, 0, 1}, test::nodes_at(model.mesh, 2, 0.0005));
+  const auto all = test::all_nodes(model.mesh);
   // Tilted velocity: one corner lands first, which excites the hourglass modes.
   model.initial_velocities.push_back({all, {0.3, 0.2, -2.0}});
   model.time.end_time = 0.03;

@@ -141,13 +141,7 @@ TEST(HexErosion, NodesLeftWithNoElementAreTakenOut) {
   press.force_per_node = {0, 0, -0.4 * M * kH * kH / 4};  // twice the collapse force
   press.ramp_time = 0.02;
   model.loads.push_back(press);
-  fem::RigidTool floor;
-  floor.name = "floor";
-  floor.surface.shape = fem::ToolShape::Plane;
-  floor.surface.point = {0, 0, 0.3 * kH};
-  floor.surface.axis = {0, 0, 1};
-  floor.contact_nodes = top;
-  model.tools.push_back(floor);
+  test::add_rigid_plane(model, "floor", {0, 0, 0.3 * kH}, {0, 0, 1}, top);
   model.time.end_time = 1.0;
   model.time.erosion_step_ratio = kRatio;
   fem::ExplicitSolver solver(model);

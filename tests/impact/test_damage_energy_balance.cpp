@@ -17,31 +17,32 @@
 
 using namespace ncfsim;
 
-TEST(DamageEnergyBalance, CrushedBlockBouncingOffAWallKeepsTheBalance) {
-  fem::Model model;
-  const int p = model.mesh.add_part("block");
-  fem::add_hex_block(model.mesh, p, {0, 0, 0.0002}, {0.003, 0.003, 0.002}, {3, 3, 2});
+namespace {
+
+// Impregnated tow (T700/epoxy constants) with strengths a tenth of the real ones, so that every
+// mode initiates in a 20 m/s impact; no element eroded.
+impact::TowDamageConstants weak_tow() {
   impact::TowDamageConstants c;
   c.density = 1550;
   c.elastic = {140e9, 9e9, 9e9, 0.3, 0.3, 0.45, 5e9, 5e9, 3.1e9};
   c.strength = {230e6, 140e6, 6e6, 3.6e6, 8e6, 6e6};
   c.fracture_energy = {90e3, 80e3, 280, 800, 800, 500};
   c.erode_on = {false, false, false, false, false, false};
-  model.materials.push_back(std::make_unique<impact::TowDamageMaterial>("tow", c));
+  return c;
+}
+
+}  // namespace
+
+TEST(DamageEnergyBalance, CrushedBlockBouncingOffAWallKeepsTheBalance) {
+  fem::Model model;
+  const int p = model.mesh.add_part("block");
+  fem::add_hex_block(model.mesh, p, {0, 0, 0.0002}, {0.003, 0.003, 0.002}, {3, 3, 2});
+  model.materials.push_back(std::make_unique<impact::TowDamageMaterial>("tow", weak_tow()));
   model.parts.resize(1);
   model.parts[0].material = 0;
   model.parts[0].hourglass_viscosity = 0;
-  fem::RigidTool wall;
-  wall.name = "wall";
-  wall.surface.shape = fem::ToolShape::Plane;
-  wall.surface.point = {0, 0, 0};
-  wall.surface.axis = {0, 0, 1};
-  for (std::int32_t i = 0; i < static_cast<std::int32_t>(model.mesh.n_nodes()); ++i)
-    wall.contact_nodes.push_back(i);
-  wall.friction = 0.3;
-  model.tools.push_back(wall);
-  std::vector<std::int32_t> all = wall.contact_nodes;
-  model.initial_velocities.push_back({all, {3.0, 2.0, -20.0}});
+  test::add_rigid_plane(model, "wall", {0, 0, 0}, {0, 0, 1}, test::all_nodes(model.mesh), 0.3);
+  model.initial_velocities.push_back({test::all_nodes(model.mesh), {3.0, 2.0, -20.0}});
   model.time.end_time = 4e-4;
   fem::ExplicitSolver solver(model);
   double worst = 0, largest_damage = 0;
@@ -80,13 +81,7 @@ TEST(DamageEnergyBalance, BondedPliesCrushedOnAWallKeepTheBalance) {
   const int lower = model.mesh.add_part("lower"), upper = model.mesh.add_part("upper");
   fem::add_hex_block(model.mesh, lower, {0, 0, 0.0002}, {0.003, 0.003, 0.001}, {3, 3, 1});
   fem::add_hex_block(model.mesh, upper, {0, 0, 0.0012}, {0.003, 0.003, 0.001}, {3, 3, 1});
-  impact::TowDamageConstants c;
-  c.density = 1550;
-  c.elastic = {140e9, 9e9, 9e9, 0.3, 0.3, 0.45, 5e9, 5e9, 3.1e9};
-  c.strength = {230e6, 140e6, 6e6, 3.6e6, 8e6, 6e6};
-  c.fracture_energy = {90e3, 80e3, 280, 800, 800, 500};
-  c.erode_on = {false, false, false, false, false, false};
-  model.materials.push_back(std::make_unique<impact::TowDamageMaterial>("tow", c));
+  model.materials.push_back(std::make_unique<impact::TowDamageMaterial>("tow", weak_tow()));
   model.parts.resize(2);
   for (auto& pp : model.parts) pp.material = 0, pp.hourglass_viscosity = 0;
   // Faces: the lower block's top (face 1, +z) under the upper block's bottom (face 0, -z).
@@ -119,16 +114,8 @@ TEST(DamageEnergyBalance, BondedPliesCrushedOnAWallKeepTheBalance) {
   touch.groups = {{"lower", {lower}}, {"upper", {upper}}};
   touch.pairs = {{0, 1, 0.3}};
   model.contacts.push_back(std::make_unique<fem::PenaltyContact>(touch));
-  fem::RigidTool wall;
-  wall.name = "wall";
-  wall.surface.shape = fem::ToolShape::Plane;
-  wall.surface.point = {0, 0, 0};
-  wall.surface.axis = {0, 0, 1};
-  for (std::int32_t i = 0; i < static_cast<std::int32_t>(model.mesh.n_nodes()); ++i)
-    wall.contact_nodes.push_back(i);
-  wall.friction = 0.3;
-  model.tools.push_back(wall);
-  model.initial_velocities.push_back({wall.contact_nodes, {3.0, 2.0, -20.0}});
+  test::add_rigid_plane(model, "wall", {0, 0, 0}, {0, 0, 1}, test::all_nodes(model.mesh), 0.3);
+  model.initial_velocities.push_back({test::all_nodes(model.mesh), {3.0, 2.0, -20.0}});
   model.time.end_time = 4e-4;
   fem::ExplicitSolver solver(model);
   double worst = 0;
