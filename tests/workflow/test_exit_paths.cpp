@@ -87,6 +87,27 @@ TEST(CliExitPaths, SignalRightAfterTheStartLeavesAnInterruptedRun) {
   EXPECT_EQ(summary(out)["status"], "interrupted");
 }
 
+// Ctrl-C after the last cycle, while the figures are drawn (the log's energy-balance line comes
+// just before them; drawing takes a good fraction of a second): the results are complete, but
+// the run must not end "completed" with exit 0 as if nothing had happened.
+TEST(CliExitPaths, InterruptWhileFiguresAreDrawnEndsInterrupted) {
+  const fs::path out = fresh_dir("exit_sigint_figures");
+  const fs::path log = out.string() + ".log";
+  const pid_t pid = spawn({"run", kCube.string(), "-o", out.string()}, log);
+  bool drawing = false;
+  for (int i = 0; i < 30000 && !drawing; ++i) {
+    drawing = slurp(out / "log.txt").find("energy balance at t") != std::string::npos;
+    if (!drawing) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(drawing) << slurp(log);
+  kill(pid, SIGINT);
+  EXPECT_EQ(wait_code(pid), 1) << slurp(log);
+  const auto s = summary(out);
+  EXPECT_EQ(s["status"], "interrupted");
+  EXPECT_EQ(s["figures_complete"], false);
+  EXPECT_GT(s["time_reached_s"].get<double>(), 0.0149) << "the run itself had completed";
+}
+
 TEST(CliExitPaths, ClosedStdoutDoesNotKillTheRun) {
   const fs::path out = fresh_dir("exit_closed_pipe");
   int fds[2];

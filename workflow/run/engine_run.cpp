@@ -361,6 +361,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   if (StopRequest::requested() && r.status == "completed") {
     // Ctrl-C after the last cycle: the results are complete, the figures are not all drawn.
     r.status = "interrupted";
+    r.summary["status"] = r.status;
     r.summary["figures_complete"] = false;
     r.write_summary();
     r.log->warn(
