@@ -242,8 +242,7 @@ int main(int argc, char** argv) {
     }
     if (*report) {
       require_output_folder(folder);
-      std::ifstream sum(std::filesystem::path(folder) / "summary.json");
-      const auto js = nlohmann::json::parse(sum, nullptr, false);
+      const auto js = wf::read_json_file(std::filesystem::path(folder) / "summary.json");
       if (js.is_object() && js.value("stage", "") == "workflow")
         wf::write_workflow_report(folder);
       else

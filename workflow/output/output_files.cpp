@@ -5,6 +5,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
@@ -38,6 +39,27 @@ std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out
   log->set_level(spdlog::level::debug);
   log->flush_on(spdlog::level::info);
   return log;
+}
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+nlohmann::json read_json_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) return nullptr;
+  const auto j = nlohmann::json::parse(in, nullptr, false);
+  return j.is_discarded() ? nlohmann::json(nullptr) : j;
+}
+
+std::string hms(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+  const auto s = static_cast<long>(seconds + 0.5);
+  if (s >= 3600) return fmt::format("{}:{:02}:{:02}", s / 3600, (s / 60) % 60, s % 60);
+  return fmt::format("{:02}:{:02}", s / 60, s % 60);
 }
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
@@ -136,13 +158,9 @@ OutputFolder OutputFolder::claim(const std::filesystem::path& dir, bool overwrit
   fs::create_directories(dir);
   const fs::path manifest = dir / kManifest;
   if (fs::exists(manifest)) {
-    nlohmann::json m;
-    try {
-      std::ifstream in(manifest);
-      m = nlohmann::json::parse(in);
-    } catch (const std::exception&) {
+    const nlohmann::json m = read_json_file(manifest);
+    if (!m.is_object())
       throw InputError(manifest.string(), "", "cannot be read: remove it, or give another folder");
-    }
     std::vector<std::string> files, dirs;
     list_tree(dir, keep, files, dirs);
     std::vector<std::string> ours, keep_files = m.value("before_files", std::vector<std::string>{}),
@@ -208,15 +226,9 @@ void OutputFolder::record(const std::filesystem::path& dir,
                           const std::vector<std::filesystem::path>& files) {
   namespace fs = std::filesystem;
   const fs::path manifest = dir / kManifest;
-  if (!fs::exists(manifest)) return;
-  nlohmann::json m;
-  try {
-    std::ifstream in(manifest);
-    m = nlohmann::json::parse(in);
-  } catch (const std::exception&) {
-    return;  // claim() reports an unreadable manifest on the next run
-  }
-  if (!m.value("complete", false)) return;
+  nlohmann::json m = read_json_file(manifest);
+  // No manifest: nothing to add to; an unreadable one: claim() reports it on the next run.
+  if (!m.is_object() || !m.value("complete", false)) return;
   auto ours = m.value("files", std::vector<std::string>{});
   auto before = m.value("before_files", std::vector<std::string>{});
   for (const auto& f : files) {

@@ -19,6 +19,13 @@ enum class Verbosity { Quiet, Normal, Verbose };
 /// Console + log.txt logger; the same lines go to both (the console honours the verbosity).
 std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out_dir, Verbosity v);
 
+/// The whole file as bytes; empty when it cannot be read.
+std::string read_file(const std::filesystem::path& path);
+/// A JSON file (summary.json, a manifest); null when it is missing or cannot be parsed.
+nlohmann::json read_json_file(const std::filesystem::path& path);
+/// Wall time as "MM:SS", "H:MM:SS" past an hour, "--:--" when not a time.
+std::string hms(double seconds);
+
 /// Writes text to `path` so that a reader sees either the old or the new complete file
 /// (fem/io/atomic_file.hpp).
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);

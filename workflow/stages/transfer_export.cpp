@@ -18,13 +18,8 @@ void require_transfer_run(const std::filesystem::path& dir) {
   const auto summary = dir / "summary.json";
   if (!std::filesystem::is_regular_file(summary))
     throw InputError(dir.string(), "", "no summary.json: not the output folder of a run");
-  nlohmann::json j;
-  try {
-    std::ifstream in(summary);
-    j = nlohmann::json::parse(in);
-  } catch (const std::exception&) {
-    throw InputError(dir.string(), "", "summary.json cannot be read");
-  }
+  const nlohmann::json j = read_json_file(summary);
+  if (!j.is_object()) throw InputError(dir.string(), "", "summary.json cannot be read");
   if (j.value("stage", std::string()) != "transfer" ||
       j.value("status", std::string()) != "completed")
     throw InputError(dir.string(), "",

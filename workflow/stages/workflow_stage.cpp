@@ -32,23 +32,6 @@ namespace {
 
 constexpr const char* kInputsFile = "stage_inputs.json";
 
-std::string read_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  if (!in) return json();
-  try {
-    return json::parse(in);
-  } catch (const json::exception&) {
-    return json();
-  }
-}
-
 class Md5 {
  public:
   Md5() : h_(vtksysMD5_New()) { vtksysMD5_Initialize(h_); }
@@ -117,7 +100,7 @@ void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream
     const fs::path f = fs::path(value).is_absolute() ? fs::path(value) : dir / value;
     if (!fs::is_regular_file(f, ec)) continue;
     md5.add(key);
-    md5.add(read_bytes(f));
+    md5.add(read_file(f));
     files.push_back(f.lexically_normal().string());
   }
   json up = json::object();
@@ -136,16 +119,10 @@ void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream
 }
 
 bool unchanged(const StagePlan& p) {
-  const json old = read_json(p.folder / kInputsFile);
-  const json sum = read_json(p.folder / "summary.json");
+  const json old = read_json_file(p.folder / kInputsFile);
+  const json sum = read_json_file(p.folder / "summary.json");
   return old.is_object() && old.value("hash", "") == p.hash && sum.is_object() &&
          sum.value("status", "") == "completed";
-}
-
-std::string hms(double s) {
-  if (!std::isfinite(s) || s < 0) return "?";
-  const long t = std::lround(s);
-  return fmt::format("{:02d}:{:02d}:{:02d}", t / 3600, (t / 60) % 60, t % 60);
 }
 
 std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out) {
@@ -191,7 +168,6 @@ int run_workflow_stage(const StageCall& call) {
   for (const auto& p : plans) stage_dirs.push_back(p.spec.name);
   const OutputFolder folder = OutputFolder::claim(out, call.options.overwrite, stage_dirs);
   auto log = make_run_logger(out, call.options.verbosity);
-  StopRequest::install();
   const auto t0 = std::chrono::steady_clock::now();
   const auto wall = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -206,7 +182,7 @@ int run_workflow_stage(const StageCall& call) {
   // Stage estimates for the ETA: the wall time of its last completed run, where there is one.
   std::vector<double> estimate(n, -1);
   for (std::size_t k = 0; k < n; ++k) {
-    const json old = read_json(plans[k].folder / "summary.json");
+    const json old = read_json_file(plans[k].folder / "summary.json");
     if (old.is_object() && old.contains("wall_seconds") && old["wall_seconds"].is_number())
       estimate[k] = old["wall_seconds"].get<double>();
   }
@@ -271,7 +247,7 @@ int run_workflow_stage(const StageCall& call) {
       error = e.what();
       log->error("{} numerical failure: {}", tag, e.what());
     }
-    const json ss = read_json(p.folder / "summary.json");
+    const json ss = read_json_file(p.folder / "summary.json");
     std::string status = ss.is_object() ? ss.value("status", "failed") : "failed";
     if (rc == kBadInput)
       status = "bad_input";  // found before the stage wrote its summary
@@ -397,7 +373,7 @@ bool ring_plot(const fs::path& dir, const json& stages, std::string& why) {
 }  // namespace
 
 void write_workflow_report(const fs::path& dir) {
-  const json s = read_json(dir / "summary.json");
+  const json s = read_json_file(dir / "summary.json");
   if (!s.is_object() || !s.contains("stages"))
     throw std::runtime_error((dir / "summary.json").string() + " is not a workflow's summary");
   const std::string name = s.value("case", "workflow");
@@ -414,7 +390,7 @@ void write_workflow_report(const fs::path& dir) {
   std::map<std::string, json> sums;
   for (const auto& e : s["stages"])
     sums[e["name"].get<std::string>()] =
-        read_json(dir / e["folder"].get<std::string>() / "summary.json");
+        read_json_file(dir / e["folder"].get<std::string>() / "summary.json");
 
   h << "<h2>Process</h2>\n<table><tr><th>stage</th><th>kind</th><th>case</th><th>this run</th>"
        "<th>wall (this run)</th><th>wall (stage)</th><th>energy balance "
