@@ -566,41 +566,41 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     ke *= 0.5;
     const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
     for (auto& m : motions_) m->velocities(t_half, motion_v_.data());
+    // Holds DOF d (v^{n-1/2} = vo, free v^{n+1/2} in vel) at velocity vp: the works of the forces
+    // over the new increment and the kinetic energy are corrected; returns the reaction.
+    const auto hold = [&](std::size_t d, double vo, double vp) {
+      const double m = mm[d], vfree = vel[d], dv = vp - vfree;
+      vel[d] = vp;
+      if (xfused) xfused[d] += dt_new * dv;
+      ext_new += fe[d] * dt_new * dv;
+      damp_new += fdamp[d] * dt_new * dv;
+      con_new += fcon[d] * dt_new * dv;
+      ke += 0.5 * m * vo * dv;
+      return m * dv * inv_dt_mid;
+    };
     for (std::size_t k = 0; k < constrained_.size(); ++k) {
       const std::size_t d = constrained_[k];
       const std::uint8_t code = fixed_mask_[d];
-      const double vo = constrained_vo_[k], m = mm[d], vfree = vel[d];
+      const double vo = constrained_vo_[k];
       double vp = 0.0;
       if (code == 254) {
         vp = motion_v_[k];
       } else if (code > 1) {
         vp = vpres[code - 2].arr()[d % 3];
       }
-      const double r = m * (vp - vfree) * inv_dt_mid;
+      const double r = hold(d, vo, vp);
       rr[d] = r;
-      vel[d] = vp;
-      const double dv = vp - vfree;
-      if (xfused) xfused[d] += dt_new * dv;
       ext_old += r * dtp * vo;
-      ext_new += fe[d] * dt_new * dv + r * dt_new * vp;
-      damp_new += fdamp[d] * dt_new * dv;
-      con_new += fcon[d] * dt_new * dv;
-      ke += 0.5 * m * vo * dv;
+      ext_new += r * dt_new * vp;
     }
     // Nodes freed by erosion this cycle (free_orphan_nodes) are held at rest like a fixed DOF;
-    // the work of that reaction, -1/2 r du_old as the external work books it, is their kinetic
-    // energy (product form). Then a zero inverse mass keeps them there.
+    // the work of that reaction, 1/2 r du_old as the external work would book it, is their
+    // kinetic energy (product form), which leaves the model. Then a zero inverse mass keeps them.
     for (std::size_t k = 0; k < freeing_.size(); ++k) {
       const std::size_t d = freeing_[k];
-      const double vfree = vel[d], m = mm[d], dv = -vfree, vo = freeing_vo_[k];
-      energy_.eroded_kinetic += 0.5 * m * vfree * vo * dtp * inv_dt_mid;
-      vel[d] = 0;
+      const double vo = freeing_vo_[k];
+      energy_.eroded_kinetic -= 0.5 * hold(d, vo, 0.0) * dtp * vo;
       inv_mass_[d] = 0;
-      if (xfused) xfused[d] += dt_new * dv;
-      ext_new += fe[d] * dt_new * dv;
-      damp_new += fdamp[d] * dt_new * dv;
-      con_new += fcon[d] * dt_new * dv;
-      ke += 0.5 * m * vo * dv;
     }
     freeing_.clear();
     w_ext_.add(ext_old, ext_new);
