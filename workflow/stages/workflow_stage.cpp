@@ -149,6 +149,48 @@ std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out) {
   return plans;
 }
 
+struct StageOutcome {
+  int rc = kOtherError;
+  std::string status;  // the stage's summary status, or bad_input / numerical_failure / failed
+  std::string error;   // the message of bad input or a numerical failure thrown by the stage
+};
+
+// Runs one stage into its folder; its stage_inputs.json is removed first, so a stage stopped
+// half-way is never taken as done.
+StageOutcome run_planned_stage(const StagePlan& p, const RunOptions& options, spdlog::logger& log,
+                               const std::string& tag) {
+  fs::create_directories(p.folder);
+  fs::remove(p.folder / kInputsFile);
+  StageCall sc;
+  sc.case_file = p.spec.case_file;
+  sc.overrides = p.overrides;
+  sc.options = options;
+  sc.options.out_dir = p.folder;
+  sc.options.overrides = p.overrides;
+  sc.options.force_stages.clear();
+  StageOutcome o;
+  try {
+    o.rc = find_stage(p.kind, p.spec.case_file).run(sc);
+  } catch (const InputError& e) {
+    o.rc = kBadInput;
+    o.error = e.what();
+    log.error("{} bad input: {}", tag, e.what());
+  } catch (const NumericalError& e) {
+    o.rc = kNumericalFailure;
+    o.error = e.what();
+    log.error("{} numerical failure: {}", tag, e.what());
+  }
+  const json ss = read_json_file(p.folder / "summary.json");
+  o.status = ss.is_object() ? ss.value("status", "failed") : "failed";
+  if (o.rc == kBadInput)
+    o.status = "bad_input";  // found before the stage wrote its summary
+  else if (o.rc == kNumericalFailure && o.status == "completed")
+    o.status = "numerical_failure";
+  else if (o.rc != kSuccess && o.status == "completed")
+    o.status = "failed";
+  return o;
+}
+
 }  // namespace
 
 int run_workflow_stage(const StageCall& call) {
@@ -224,40 +266,13 @@ int run_workflow_stage(const StageCall& call) {
               p.overrides.empty() ? "" : " (with --set)", hms(wall()),
               known ? hms(left) + " (from the last run's stage times)" : "unknown (first run)");
     for (const auto& o : p.overrides) log->debug("{}   --set {}", tag, o);
-    fs::create_directories(p.folder);
-    fs::remove(p.folder / kInputsFile);  // a stage stopped half-way is never taken as done
-    StageCall sc;
-    sc.case_file = p.spec.case_file;
-    sc.overrides = p.overrides;
-    sc.options = call.options;
-    sc.options.out_dir = p.folder;
-    sc.options.overrides = p.overrides;
-    sc.options.force_stages.clear();
     const double ts = wall();
-    int rc = kOtherError;
-    std::string error;
-    try {
-      rc = find_stage(p.kind, p.spec.case_file).run(sc);
-    } catch (const InputError& e) {
-      rc = kBadInput;
-      error = e.what();
-      log->error("{} bad input: {}", tag, e.what());
-    } catch (const NumericalError& e) {
-      rc = kNumericalFailure;
-      error = e.what();
-      log->error("{} numerical failure: {}", tag, e.what());
-    }
-    const json ss = read_json_file(p.folder / "summary.json");
-    std::string status = ss.is_object() ? ss.value("status", "failed") : "failed";
-    if (rc == kBadInput)
-      status = "bad_input";  // found before the stage wrote its summary
-    else if (rc == kNumericalFailure && status == "completed")
-      status = "numerical_failure";
-    else if (rc != kSuccess && status == "completed")
-      status = "failed";
+    const StageOutcome o = run_planned_stage(p, call.options, *log, tag);
+    const int rc = o.rc;
+    const std::string& status = o.status;
+    if (!o.error.empty()) entry["error"] = o.error;
     entry["wall_seconds"] = wall() - ts;
     entry["status"] = status;
-    if (!error.empty()) entry["error"] = error;
     summary["stages"].push_back(entry);
     if (rc == kSuccess && status == "completed") {
       write_file_atomically(p.folder / kInputsFile, p.inputs.dump(2) + "\n");
