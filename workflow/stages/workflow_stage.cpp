@@ -387,32 +387,17 @@ bool ring_plot(const fs::path& dir, const json& stages, std::string& why) {
 
 }  // namespace
 
-void write_workflow_report(const fs::path& dir) {
-  const json s = read_json_file(dir / "summary.json");
-  if (!s.is_object() || !s.contains("stages"))
-    throw std::runtime_error((dir / "summary.json").string() + " is not a workflow's summary");
-  const std::string name = s.value("case", "workflow");
-  std::ostringstream h;
-  h << html_head(name + " - ncfsim workflow");
-  const std::string status = s.value("status", "unknown");
-  h << "<h1>" << escape(name) << "</h1>\n<p>ncfsim " << escape(s.value("ncfsim_version", "?"))
-    << " &middot; workflow " << escape(s.value("case_file", ""))
-    << " &middot; status <span class=\"" << (status == "completed" ? "ok" : "bad") << "\">"
-    << escape(status) << "</span> &middot; wall " << hms(s.value("wall_seconds", 0.0)) << "</p>\n";
-  if (s.contains("error"))
-    h << "<p class=\"bad\">" << escape(s["error"].get<std::string>()) << "</p>\n";
+namespace {
 
-  std::map<std::string, json> sums;
-  for (const auto& e : s["stages"])
-    sums[e["name"].get<std::string>()] =
-        read_json_file(dir / e["folder"].get<std::string>() / "summary.json");
-
+// Stages, their status, wall times, energy balance, reports.
+void process_section(std::ostream& h, const fs::path& dir, const json& stages,
+                     const std::map<std::string, json>& sums) {
   h << "<h2>Process</h2>\n<table><tr><th>stage</th><th>kind</th><th>case</th><th>this run</th>"
        "<th>wall (this run)</th><th>wall (stage)</th><th>energy balance "
        "error</th><th>report</th></tr>\n";
-  for (const auto& e : s["stages"]) {
+  for (const auto& e : stages) {
     const std::string st = e.value("status", "?"), nm = e["name"].get<std::string>();
-    const json& ss = sums[nm];
+    const json& ss = sums.at(nm);
     std::string balance = "-";
     if (ss.is_object() && ss.contains("energy_balance_error") &&
         ss["energy_balance_error"].is_number()) {
@@ -433,19 +418,22 @@ void write_workflow_report(const fs::path& dir) {
       << "</td></tr>\n";
   }
   h << "</table>\n";
+}
 
-  // The drapes compared: rings and quadrant maxima.
+// The drapes compared: the rings of every drape stage on one plot and the quadrant maxima.
+void drapes_section(std::ostream& h, const fs::path& dir, const json& stages,
+                    const std::map<std::string, json>& sums) {
   std::string why;
   bool any_ring = false;
   try {
-    any_ring = ring_plot(dir, s["stages"], why);
+    any_ring = ring_plot(dir, stages, why);
   } catch (const std::exception& ex) {
     why = ex.what();
   }
   std::ostringstream q;
-  for (const auto& e : s["stages"]) {
+  for (const auto& e : stages) {
     const std::string nm = e["name"].get<std::string>();
-    const json& ss = sums[nm];
+    const json& ss = sums.at(nm);
     for (const char* prefix : {"", "kinematic_"}) {
       if (!ss.is_object() || !ss.contains(std::string(prefix) + "max_shear_deg_q1")) continue;
       q << "<tr><td>" << escape(nm) << (*prefix ? " (pin-jointed net)" : "") << "</td>";
@@ -468,8 +456,11 @@ void write_workflow_report(const fs::path& dir) {
            "[deg]</th><th>max q4 [deg]</th></tr>\n"
         << q.str() << "</table>\n";
   }
+}
 
-  // Key results.
+// Key results of every stage that has them.
+void key_results_section(std::ostream& h, const json& stages,
+                         const std::map<std::string, json>& sums) {
   static const std::vector<std::pair<const char*, const char*>> keys{
       {"punch_displacement_m", "punch stroke [m]"},
       {"kinetic_to_internal_max", "kinetic / internal, max"},
@@ -483,9 +474,9 @@ void write_workflow_report(const fs::path& dir) {
       {"energy_absorbed_J", "energy absorbed [J]"},
       {"dominant_failure_mode", "dominant failure mode"}};
   h << "<h2>Key results</h2>\n<table><tr><th>stage</th><th>quantity</th><th>value</th></tr>\n";
-  for (const auto& e : s["stages"]) {
+  for (const auto& e : stages) {
     const std::string nm = e["name"].get<std::string>();
-    const json& ss = sums[nm];
+    const json& ss = sums.at(nm);
     if (!ss.is_object()) continue;
     for (const auto& [k, label] : keys)
       if (ss.contains(k))
@@ -494,10 +485,12 @@ void write_workflow_report(const fs::path& dir) {
           << "</td></tr>\n";
   }
   h << "</table>\n";
+}
 
-  // Every stage's figures (formed part by shear angle, Vf map, failure modes, force curves, energy
-  // balances).
-  for (const auto& e : s["stages"]) {
+// Every stage's figures (formed part by shear angle, Vf map, failure modes, force curves,
+// energy balances).
+void figures_section(std::ostream& h, const fs::path& dir, const json& stages) {
+  for (const auto& e : stages) {
     const std::string nm = e["name"].get<std::string>();
     const fs::path figs = dir / nm / "figures";
     if (!fs::is_directory(figs)) continue;
@@ -512,11 +505,13 @@ void write_workflow_report(const fs::path& dir) {
         << escape(f) << "\"><figcaption>" << escape(nm) << ": " << escape(f)
         << "</figcaption></figure>\n";
   }
+}
 
-  // Warnings of every stage.
+// The warnings of every stage, in one list.
+void warnings_section(std::ostream& h, const fs::path& dir, const json& stages) {
   std::ostringstream w;
   std::size_t n_warn = 0;
-  for (const auto& e : s["stages"]) {
+  for (const auto& e : stages) {
     const std::string nm = e["name"].get<std::string>();
     std::ifstream in(dir / nm / "warnings.txt");
     std::string line;
@@ -528,6 +523,36 @@ void write_workflow_report(const fs::path& dir) {
     h << "<p>None.</p>\n";
   else
     h << "<ul>\n" << w.str() << "</ul>\n";
+}
+
+}  // namespace
+
+void write_workflow_report(const fs::path& dir) {
+  const json s = read_json_file(dir / "summary.json");
+  if (!s.is_object() || !s.contains("stages"))
+    throw std::runtime_error((dir / "summary.json").string() + " is not a workflow's summary");
+  const std::string name = s.value("case", "workflow");
+  std::ostringstream h;
+  h << html_head(name + " - ncfsim workflow");
+  const std::string status = s.value("status", "unknown");
+  h << "<h1>" << escape(name) << "</h1>\n<p>ncfsim " << escape(s.value("ncfsim_version", "?"))
+    << " &middot; workflow " << escape(s.value("case_file", ""))
+    << " &middot; status <span class=\"" << (status == "completed" ? "ok" : "bad") << "\">"
+    << escape(status) << "</span> &middot; wall " << hms(s.value("wall_seconds", 0.0)) << "</p>\n";
+  if (s.contains("error"))
+    h << "<p class=\"bad\">" << escape(s["error"].get<std::string>()) << "</p>\n";
+
+  std::map<std::string, json> sums;
+  for (const auto& e : s["stages"])
+    sums[e["name"].get<std::string>()] =
+        read_json_file(dir / e["folder"].get<std::string>() / "summary.json");
+
+  const json& stages = s["stages"];
+  process_section(h, dir, stages, sums);
+  drapes_section(h, dir, stages, sums);
+  key_results_section(h, stages, sums);
+  figures_section(h, dir, stages);
+  warnings_section(h, dir, stages);
   h << "<p><a href=\"summary.json\">summary.json</a> &middot; <a href=\"log.txt\">log.txt</a></p>\n"
        "</body></html>\n";
   write_file_atomically(dir / "report.html", h.str());
