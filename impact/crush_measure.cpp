@@ -33,7 +33,8 @@ CrushMeasure::CrushMeasure(const fem::ExplicitSolver& s, int punch, double cfc)
   const auto& model = s.model();
   punch_name_ = model.tools.at(static_cast<std::size_t>(punch)).name;
   for (const auto& c : model.contacts)
-    if (const auto* t = dynamic_cast<const fem::TiedContact*>(c.get())) ties_.push_back(t);
+    if (const auto* t = dynamic_cast<const fem::TiedContact*>(c.get()))
+      (t->config().slave_nodes.empty() ? ties_ : stitch_ties_).push_back(t);
   const auto& groups = s.groups();
   for (std::size_t k = 0; k < groups.size(); ++k)
     if (const auto* b = fem::block_of<fem::Hex8Block>(*groups[k]))
@@ -51,6 +52,11 @@ std::vector<std::string> CrushMeasure::setup_lines() const {
   for (const auto* t : ties_)
     lines.push_back(fmt::format("crush: resin bond '{}': {} tied nodes over {:.5g} mm^2", t->name(),
                                 t->n_ties(), 1e6 * t->tied_area()));
+  for (const auto* t : stitch_ties_)
+    lines.push_back(fmt::format(
+        "crush: cured stitch '{}': {} stitch nodes tied to the nearest tow face within {:.4g} mm "
+        "({} beside no face: free)",
+        t->name(), t->n_ties(), 1e3 * t->search_distance(), t->untied_nodes()));
   return lines;
 }
 

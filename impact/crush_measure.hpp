@@ -47,7 +47,8 @@ class CrushMeasure final : public fem::RunMeasure {
   int punch_;
   double cfc_;
   std::string punch_name_;
-  std::vector<const fem::TiedContact*> ties_;
+  std::vector<const fem::TiedContact*> ties_;         // the resin bonds
+  std::vector<const fem::TiedContact*> stitch_ties_;  // the cured stitch's nodes on the tows
   std::vector<std::size_t> damage_groups_;  // indices of the hexahedron groups with a damage law
   // Samples at the history rows: time, punch displacement and force (resistance, N).
   mutable std::vector<double> time_, stroke_, force_;

@@ -26,6 +26,13 @@ void check(const ExportModel& m) {
   for (auto k : m.material)
     if (k < 0 || static_cast<std::size_t>(k) >= m.materials.size())
       throw std::invalid_argument("export: an element names a material that does not exist");
+  const auto& st = m.stitches;
+  for (const auto& b : st.bars)
+    for (auto n : b)
+      if (n < 0 || static_cast<std::size_t>(n) >= m.nodes.size())
+        throw std::invalid_argument("export: a stitch bar names a node that does not exist");
+  if (!st.bars.empty() && !(st.modulus > 0 && st.area > 0 && st.density > 0))
+    throw std::invalid_argument("export: stitch bars need a positive modulus, area and density");
 }
 
 }  // namespace
@@ -64,6 +71,16 @@ void write_abaqus_inp(const std::filesystem::path& file, const ExportModel& m) {
                      mat.name, mat.density);
     s += fmt::format("{:.6g}, {:.6g}, {:.6g}, {:.6g}, {:.6g}, {:.6g}, {:.6g}, {:.6g}\n{:.6g}\n",
                      c.E1, c.E2, c.E3, c.nu12, c.nu13, c.nu23, c.G12, c.G13, c.G23);
+  }
+  if (const auto& st = m.stitches; !st.bars.empty()) {
+    s += "*ELEMENT, TYPE=T3D2, ELSET=stitch\n";
+    for (std::size_t b = 0; b < st.bars.size(); ++b)
+      s += fmt::format("{}, {}, {}\n", m.hex.size() + b + 1, st.bars[b][0] + 1, st.bars[b][1] + 1);
+    s += fmt::format("*SOLID SECTION, ELSET=stitch, MATERIAL=STITCH\n{:.6g},\n", st.area);
+    s += fmt::format(
+        "*MATERIAL, NAME=STITCH\n*DENSITY\n{:.6g}\n*ELASTIC\n{:.6g}, 0.\n"
+        "** the yarn carries tension only (*NO COMPRESSION: Abaqus/Standard)\n*NO COMPRESSION\n",
+        st.density, st.modulus);
   }
   for (const auto& t : m.ties) {
     for (const char* side : {"slave", "master"}) {
@@ -105,6 +122,19 @@ void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& 
                      h[6] + 1, h[7] + 1);
     s += fmt::format("{:>16.9e}{:>16.9e}{:>16.9e}\n{:>16.9e}{:>16.9e}{:>16.9e}\n", R[0], R[3], R[6],
                      R[1], R[4], R[7]);
+  }
+  if (const auto& st = m.stitches; !st.bars.empty()) {
+    const std::size_t id = m.materials.size() + 1;
+    s += fmt::format("*PART\nstitch\n{:>10}{:>10}{:>10}\n", id, id, id);
+    // A discrete beam with a cable area CA is a cable: its mass from the density and CA.
+    s += fmt::format("*SECTION_BEAM\n{:>10}{:>10}\n{:>10.4g}{:>10.4g}{:>10}{:>10.4g}\n", id, 6, 0.0,
+                     0.0, 0, st.area);
+    s += fmt::format("*MAT_CABLE_DISCRETE_BEAM\n{:>10}{:>10.4g}{:>10.4g}\n", id, st.density,
+                     st.modulus);
+    s += "*ELEMENT_BEAM\n";
+    for (std::size_t b = 0; b < st.bars.size(); ++b)
+      s += fmt::format("{:>8}{:>8}{:>8}{:>8}\n", m.hex.size() + b + 1, id, st.bars[b][0] + 1,
+                       st.bars[b][1] + 1);
   }
   int set = 0;
   for (const auto& t : m.ties) {
@@ -167,9 +197,10 @@ DeckCounts read_deck(const std::filesystem::path& file, const std::string& forma
     if (format == "abaqus") {
       if (block == "*NODE")
         ++c.nodes;
-      else if (block.rfind("*ELEMENT", 0) == 0)
+      else if (block.rfind("*ELEMENT", 0) == 0) {
         ++c.elements;
-      else if (block.rfind("*DISTRIBUTION,", 0) == 0) {
+        if (block.find("TYPE=T3D2") != std::string::npos) ++c.bars;
+      } else if (block.rfind("*DISTRIBUTION,", 0) == 0) {
         const auto v = numbers(line);
         if (v.size() == 7)
           c.axes.push_back({v[1], v[2], v[3], v[4], v[5], v[6]});
@@ -179,6 +210,8 @@ DeckCounts read_deck(const std::filesystem::path& file, const std::string& forma
     } else {
       if (block == "*NODE")
         ++c.nodes;
+      else if (block == "*ELEMENT_BEAM")
+        ++c.elements, ++c.bars;
       else if (block == "*ELEMENT_SOLID_ORTHO") {
         if (ortho_line % 3 == 0) {
           ++c.elements;

@@ -29,6 +29,13 @@ struct ExportTie {
   std::vector<std::pair<std::int32_t, int>> slave, master;
 };
 
+/// Kept stitches: tension-only yarn bars between model nodes (Abaqus T3D2 with *NO COMPRESSION,
+/// LS-DYNA cable: *SECTION_BEAM ELFORM 6 with its area and *MAT_CABLE_DISCRETE_BEAM).
+struct ExportStitches {
+  std::vector<std::array<std::int32_t, 2>> bars;  // 0-based node indices
+  double modulus = 0, area = 0, density = 0;      // Pa, m^2, kg/m^3
+};
+
 struct ExportModel {
   std::vector<std::array<double, 3>> nodes;
   std::vector<std::array<std::int32_t, 8>> hex;  // 0-based node indices, VTK order
@@ -36,6 +43,7 @@ struct ExportModel {
   std::vector<std::int32_t> material;            // per element, index into materials
   std::vector<ExportMaterial> materials;
   std::vector<ExportTie> ties;
+  ExportStitches stitches;
 };
 
 /// Written atomically (fem/io/atomic_file.hpp); throw std::runtime_error naming the file.
@@ -44,6 +52,7 @@ void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& 
 
 struct DeckCounts {
   std::size_t nodes = 0, elements = 0, orientations = 0, materials = 0, ties = 0;
+  std::size_t bars = 0;  // stitch elements (counted in elements too)
   std::vector<std::array<double, 6>>
       axes;  // per element as read: a1 and a2 (Abaqus) or a1 and v (LS-DYNA)
 };

@@ -42,6 +42,36 @@ double fibre_stretch(const std::array<V3, 8>& X, const std::array<V3, 8>& x, con
   return 1.0 / back.norm();
 }
 
+// Distance from p to the hexahedron with corners x: its natural coordinates by Newton on the
+// trilinear map, clamped to the element (exact above a flat face, close elsewhere).
+double distance_to_hex(const std::array<V3, 8>& x, const V3& p) {
+  Eigen::Vector3d xi = Eigen::Vector3d::Zero();
+  auto at = [&](const Eigen::Vector3d& q, Eigen::Matrix3d* J) {
+    V3 r;
+    if (J) J->setZero();
+    for (std::size_t a = 0; a < 8; ++a) {
+      const double f[3] = {1 + kXi[a][0] * q[0], 1 + kXi[a][1] * q[1], 1 + kXi[a][2] * q[2]};
+      r += (0.125 * f[0] * f[1] * f[2]) * x[a];
+      if (J)
+        for (int k = 0; k < 3; ++k) {
+          const double dN = 0.125 * kXi[a][k] * f[(k + 1) % 3] * f[(k + 2) % 3];
+          (*J)(0, k) += dN * x[a].x;
+          (*J)(1, k) += dN * x[a].y;
+          (*J)(2, k) += dN * x[a].z;
+        }
+    }
+    return r;
+  };
+  for (int it = 0; it < 8; ++it) {
+    Eigen::Matrix3d J;
+    const V3 r = p - at(xi, &J);
+    if (!(std::abs(J.determinant()) > 0)) break;
+    const Eigen::Vector3d step = J.inverse() * Eigen::Vector3d(r.x, r.y, r.z);
+    xi = (xi + step).cwiseMax(-1.5).cwiseMin(1.5);
+  }
+  return norm(p - at(xi.cwiseMax(-1.0).cwiseMin(1.0), nullptr));
+}
+
 struct FaceRef {
   std::int32_t element;
   int face;
@@ -134,27 +164,89 @@ std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>
   return ties;
 }
 
+// The thinnest tow: the smallest distance between a hexahedron's bottom and top face centres.
+double thinnest_tow(const ImpregnatedModel& m, const std::vector<V3>& x) {
+  double thinnest = 1e300;
+  for (const auto& h : m.hex) {
+    V3 bottom, top;
+    for (std::size_t k = 0; k < 4; ++k)
+      bottom += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[0][k])])],
+          top += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[1][k])])];
+    thinnest = std::min(thinnest, norm(top - bottom));
+  }
+  return thinnest;
+}
+
+// Kept stitches: a drape stitch bar whose two end nodes lie within the capture distance of a
+// kept tow hexahedron (its box grown by that distance) is kept with its nodes at their draped
+// positions; the crush ties those nodes to the nearest tow face (the yarn cured in place).
+void capture_stitches(ImpregnatedModel& m, const fem::io::StageFrame& frame,
+                      const std::vector<V3>& x, const StitchSpec& spec) {
+  const auto& mesh = frame.mesh;
+  m.stitch_capture = spec.capture_distance > 0 ? spec.capture_distance : thinnest_tow(m, x);
+  const double reach = m.stitch_capture;
+  std::vector<double> lo(3 * m.hex.size(), 1e300), hi(3 * m.hex.size(), -1e300);
+  for (std::size_t e = 0; e < m.hex.size(); ++e)
+    for (auto n : m.hex[e])
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double c = x[static_cast<std::size_t>(n)].arr()[d];
+        lo[3 * e + d] = std::min(lo[3 * e + d], c - reach);
+        hi[3 * e + d] = std::max(hi[3 * e + d], c + reach);
+      }
+  fem::BucketGrid grid;
+  grid.build(m.hex.size(), lo.data(), hi.data());
+  std::vector<std::int8_t> beside(mesh.n_points(), -1);  // -1: not looked up yet
+  auto captured = [&](std::size_t node) {
+    if (beside[node] >= 0) return beside[node] == 1;
+    const double* q = &frame.coordinates[3 * node];
+    const V3 p{q[0], q[1], q[2]};
+    std::int32_t begin = 0, end = 0;
+    bool in = false;
+    if (grid.cell_of(q, begin, end))
+      for (std::int32_t it = begin; it < end && !in; ++it) {
+        const auto e = static_cast<std::size_t>(grid.items()[it]);
+        if (q[0] < lo[3 * e] || q[0] > hi[3 * e] || q[1] < lo[3 * e + 1] || q[1] > hi[3 * e + 1] ||
+            q[2] < lo[3 * e + 2] || q[2] > hi[3 * e + 2])
+          continue;
+        std::array<V3, 8> corners;
+        for (std::size_t a = 0; a < 8; ++a) corners[a] = x[static_cast<std::size_t>(m.hex[e][a])];
+        in = distance_to_hex(corners, p) <= reach;
+      }
+    beside[node] = in ? 1 : 0;
+    return in;
+  };
+  std::vector<std::int32_t> point_of(mesh.n_points(), -1);
+  auto point = [&](std::size_t node) {
+    if (point_of[node] < 0) {
+      point_of[node] = static_cast<std::int32_t>(m.points.size() / 3);
+      m.points.insert(m.points.end(), {frame.coordinates[3 * node], frame.coordinates[3 * node + 1],
+                                       frame.coordinates[3 * node + 2]});
+      m.point_user_id.push_back(mesh.node_user_id.empty() ? static_cast<std::int64_t>(node + 1)
+                                                          : mesh.node_user_id[node]);
+      ++m.n_stitch_nodes;
+    }
+    return point_of[node];
+  };
+  for (std::size_t b = 0; b < mesh.n_bar(); ++b) {
+    const auto i = static_cast<std::size_t>(mesh.bar2[2 * b]),
+               j = static_cast<std::size_t>(mesh.bar2[2 * b + 1]);
+    if (!captured(i) || !captured(j)) {
+      ++m.n_stitches_uncaptured;
+      continue;
+    }
+    m.stitch.push_back({point(i), point(j)});
+    m.stitch_user_id.push_back(mesh.bar_user_id.empty() ? static_cast<std::int64_t>(b + 1)
+                                                        : mesh.bar_user_id[b]);
+    m.stitch_part.push_back(mesh.bar_part.empty() ? 0 : mesh.bar_part[b]);
+  }
+}
+
 }  // namespace
 
 std::size_t ImpregnatedModel::n_tie_pairs() const {
   std::size_t n = 0;
   for (const auto& t : ties) n += t.slave.size();
   return n;
-}
-
-ExportModel ImpregnatedModel::export_model() const {
-  ExportModel m;
-  for (std::size_t i = 0; i < points.size() / 3; ++i)
-    m.nodes.push_back({points[3 * i], points[3 * i + 1], points[3 * i + 2]});
-  m.hex = hex;
-  m.frame = frame;
-  m.material = vf_class;
-  for (const auto& c : classes)
-    m.materials.push_back(
-        {fmt::format("TOW_VF{:03d}", static_cast<int>(std::lround(1000 * c.fibre_volume_fraction))),
-         c.density, c.elastic});
-  for (const auto& t : ties) m.ties.push_back({t.name, t.slave, t.master});
-  return m;
 }
 
 ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
@@ -266,6 +358,7 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
   }
 
   m.ties = tie_pairs(m, tows.current, spec.ties);
+  if (spec.stitches.keep) capture_stitches(m, frame, tows.current, spec.stitches);
   return m;
 }
 

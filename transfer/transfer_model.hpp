@@ -5,7 +5,8 @@
 // impregnated-tow properties (micromechanics at that Vf, in Vf classes), trimmed at a radius, and
 // the tied pairs of faces the resin bonds: between plies (delamination) and between tows of a ply
 // (intra-ply debond). Plain data; the transfer stage (workflow/stages) writes it, the crush reads
-// it back through the stage hand-off, `ncfsim export` turns it into an Abaqus or LS-DYNA deck.
+// it back through the stage hand-off, `ncfsim export` turns that file into an Abaqus or LS-DYNA
+// deck.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -13,7 +14,6 @@
 
 #include "fem/io/stage_handoff.hpp"
 #include "fem/vec3.hpp"
-#include "transfer/deck_export.hpp"
 #include "transfer/impregnation.hpp"
 #include "transfer/micromechanics.hpp"
 
@@ -33,6 +33,20 @@ struct TieSpec {
   double normal_strength = 0, shear_strength = 0;  // Pa, the resin's bond (0: the resin's own)
 };
 
+/// The stitches in the cured part (dropped by default, docs/case-file.md "Transfer"). Kept, a
+/// stitch bar whose two ends lie within `capture_distance` of kept tow hexahedra stays a bar with
+/// its nodes where the drape left them; the crush ties each of its nodes to the nearest tow face
+/// (the resin locks the yarn in place: the stitch-to-tow joints no longer slide).
+/// The yarn's datasheet values (docs/case-file.md): polyester, 76 dtex as the drape's stitch.
+struct StitchSpec {
+  bool keep = false;
+  double capture_distance = 0;     // m; 0: the thinnest tow's thickness
+  double modulus = 10e9;           // Pa, high-tenacity polyester yarn
+  double linear_density = 7.6e-6;  // kg/m (76 dtex)
+  double density = 1380;           // kg/m^3
+  double area() const { return linear_density / density; }
+};
+
 struct TransferSpec {
   std::vector<int> parts;  // part ids of the tow hexahedra to take (empty: every tow hexahedron)
   /// A draped hexahedron whose smallest scaled corner Jacobian is below this is not mapped: a
@@ -45,6 +59,7 @@ struct TransferSpec {
   MappingSpec mapping;
   TrimSpec trim;
   TieSpec ties;
+  StitchSpec stitches;
 };
 
 /// The tied face pairs of one interface: faces as (element, face 0..5, VTK hexahedron faces -z,
@@ -74,12 +89,18 @@ struct ImpregnatedModel {
   std::size_t n_distorted = 0;   // of those, folded or distorted past spec.min_corner_jacobian
   std::size_t n_capped = 0;      // Vf capped at the locking value
   std::size_t n_floored = 0;     // Vf raised to the undeformed value (a tow the drape spread)
-  std::size_t n_stitches = 0;    // stitch bars in the source frame (dropped)
+  std::size_t n_stitches = 0;    // stitch bars in the source frame
+  /// Kept stitch bars (spec.stitches.keep): their two points (the stitch nodes, appended to
+  /// `points` after the tows' at their draped positions), the drape's bar id and part.
+  std::vector<std::array<std::int32_t, 2>> stitch;
+  std::vector<std::int64_t> stitch_user_id;
+  std::vector<std::int32_t> stitch_part;
+  std::size_t n_stitch_nodes = 0;         // points of the kept stitches (the last ones)
+  std::size_t n_stitches_uncaptured = 0;  // an end beside no kept tow hexahedron: dropped
+  double stitch_capture = 0;              // m, the capture distance used
 
   std::size_t n_elements() const { return hex.size(); }
   std::size_t n_tie_pairs() const;
-  /// The model as a deck for `ncfsim export` (one material per Vf class).
-  ExportModel export_model() const;
 };
 
 /// Throws std::invalid_argument naming the spec's field for a bad spec, std::runtime_error when the

@@ -236,8 +236,8 @@ int main(int argc, char** argv) {
       require_output_folder(folder);
       const auto r = wf::export_impregnated(folder, deck_format);
       wf::OutputFolder::record(folder, {r.file});
-      std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs\n", r.file.c_str(),
-                  r.nodes, r.elements, r.materials, r.tie_pairs);
+      std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs, %zu stitch bars\n",
+                  r.file.c_str(), r.nodes, r.elements, r.materials, r.tie_pairs, r.bars);
       return wf::kSuccess;
     }
     if (*report) {

@@ -42,12 +42,16 @@ class TiedContact final : public ContactAlgorithm {
   /// Damage of each tie (0: intact, 1: separated; abrupt ties jump from 0 to 1).
   double damage(std::size_t t) const { return alive_[t] ? state_[t].damage : 1.0; }
   double search_distance() const { return search_distance_; }
+  /// Configured slave nodes (TiedContactConfig::slave_nodes) beside no master face: not tied.
+  std::size_t untied_nodes() const { return untied_; }
 
  private:
   /// Every tie intact, no work done yet (after the ties are found).
   void reset_tie_state();
   /// Ties each node of the configured slave faces to the nearest of its paired master faces.
   void initialise_face_pairs(const ContactSetup& setup);
+  /// Ties each of the configured slave nodes to the nearest configured master face.
+  void initialise_nodes_to_faces(const ContactSetup& setup);
   void add_tie(std::int32_t node, const std::int32_t* corners, double xi, double eta,
                std::int32_t seg_hex, double area, const double* x0, const double* mass,
                double inv_dt0_sq);
@@ -55,6 +59,7 @@ class TiedContact final : public ContactAlgorithm {
   TiedContactConfig cfg_;
   bool cohesive_ = false;
   double search_distance_ = 0;
+  std::size_t untied_ = 0;
   // One entry per tie (structure of arrays).
   std::vector<std::int32_t> node_;     // [n_tie] slave node
   std::vector<std::int32_t> corner_;   // [n_tie][4] master segment corners

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -10,6 +11,7 @@
 #include <stdexcept>
 
 #include "fem/contact/tied_contact.hpp"
+#include "fem/elements/element_kind.hpp"
 #include "fem/elements/hex8_block.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/stage_handoff.hpp"
@@ -116,6 +118,29 @@ const fem::io::FrameField& cell_field(const fem::io::StageFrame& fr, const std::
   return *f;
 }
 
+// Faces of the hexahedra that no other hexahedron shares (the tows' surfaces).
+std::vector<fem::TiedHexFace> outer_hex_faces(const fem::Mesh& mesh) {
+  const fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
+  std::map<std::array<std::int32_t, 4>, std::pair<int, fem::TiedHexFace>> faces;
+  for (std::size_t h = 0; h < hexes.size(); ++h) {
+    const auto nodes = hexes.nodes(h);
+    for (int f = 0; f < 6; ++f) {
+      std::array<std::int32_t, 4> key{};
+      for (std::size_t a = 0; a < 4; ++a)
+        key[a] =
+            nodes[static_cast<std::size_t>(fem::kHex8Faces[static_cast<std::size_t>(f)].corner[a])];
+      std::sort(key.begin(), key.end());
+      auto& [count, face] = faces[key];
+      ++count;
+      face = {static_cast<std::int32_t>(h), f};
+    }
+  }
+  std::vector<fem::TiedHexFace> out;
+  for (const auto& [key, cf] : faces)
+    if (cf.first == 1) out.push_back(cf.second);
+  return out;
+}
+
 }  // namespace
 
 void register_impact_case_types(fem::CaseTypeRegistry& registry) {
@@ -205,17 +230,63 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
   }
   for (std::size_t k = 0; k < im.classes.size(); ++k)
     if (im.classes[k].n_elements == 0) im.classes[k].name.clear();  // an empty class
+
+  // Kept stitches: bars between tow nodes, the cured yarn's constants after the hexahedra.
+  if (const std::size_t nb = rm.n_bar(); nb > 0) {
+    auto bar_value = [&](const char* name) {
+      const auto* f = fr.field(name);
+      const double v = f && f->on_cells && f->values.size() == nh + nb ? f->values[nh] : 0.0;
+      if (!(v > 0))
+        m.fail("source", fmt::format("{}: stitch bars without a positive '{}' field",
+                                     im.source.string(), name));
+      return v;
+    };
+    const double E = bar_value("stitch_modulus_Pa"), A = bar_value("stitch_area_m2"),
+                 rho = bar_value("density_kg_m3");
+    im.n_stitches = nb;
+    im.stitch_axial_stiffness = E * A;
+    im.stitch_linear_density = rho * A;
+    im.stitch_capture = bar_value("stitch_capture_m");
+    const std::size_t first_stitch_node = mesh.n_nodes();
+    fem::ElementSet& bars = mesh.elements(fem::ElementKind::Bar2);
+    for (std::size_t b = 0; b < nb; ++b) {
+      std::int32_t nodes[2];
+      for (std::size_t I = 0; I < 2; ++I) {
+        const auto p = static_cast<std::size_t>(rm.bar2[2 * b + I]);
+        if (node_of[p] < 0) {  // a stitch node: tied to the tows in assign_impregnated_parts
+          node_of[p] = static_cast<std::int32_t>(mesh.n_nodes());
+          for (int c = 0; c < 3; ++c)
+            mesh.coords.push_back(rm.points[3 * p + static_cast<std::size_t>(c)]);
+          mesh.node_user_id.push_back(rm.node_user_id.empty() ? static_cast<std::int64_t>(p + 1)
+                                                              : rm.node_user_id[p]);
+        }
+        nodes[I] = node_of[p];
+      }
+      bars.add(std::span<const std::int32_t>(nodes, 2), rm.bar_part[b]);
+      bars.user_id.push_back(rm.bar_user_id.empty() ? static_cast<std::int64_t>(b + 1)
+                                                    : rm.bar_user_id[b]);
+    }
+    for (std::size_t n = first_stitch_node; n < mesh.n_nodes(); ++n)
+      im.stitch_nodes.push_back(static_cast<std::int32_t>(n));
+  }
   mesh.fill_default_user_ids();
-  for (const auto& name : mesh.part_names) {
-    ctx.part_kind[name] = fem::PartKind::Solid;
-    ctx.generated_parts[name] = "[model] (the transfer's plies)";
+  for (std::size_t p = 0; p < mesh.part_names.size(); ++p) {
+    const auto& name = mesh.part_names[p];
+    const bool stitch = std::find(rm.bar_part.begin(), rm.bar_part.end(),
+                                  static_cast<std::int32_t>(p)) != rm.bar_part.end();
+    ctx.part_kind[name] = stitch ? fem::PartKind::Bar : fem::PartKind::Solid;
+    ctx.generated_parts[name] =
+        stitch ? "[model] (the transfer's kept stitches)" : "[model] (the transfer's plies)";
   }
 
   // Tied face pairs, by the transfer's element ids.
   const auto ties_file = im.source.parent_path() / "ties.csv";
   if (std::filesystem::exists(ties_file)) {
+    // Looked up again: adding the bars' set may have moved the hexahedra's.
+    const fem::ElementSet& hex_set = mesh.elements(fem::ElementKind::Hex8);
     std::map<std::int64_t, std::int32_t> index_of;
-    for (std::size_t h = 0; h < nh; ++h) index_of[hexes.user_id[h]] = static_cast<std::int32_t>(h);
+    for (std::size_t h = 0; h < nh; ++h)
+      index_of[hex_set.user_id[h]] = static_cast<std::int32_t>(h);
     std::vector<TieRow> rows;
     try {
       rows = read_ties_csv(ties_file);
@@ -275,8 +346,20 @@ void assign_impregnated_parts(CaseReadContext& ctx, const ImpregnatedImport& im)
   hexes.material.resize(hexes.size());
   for (std::size_t h = 0; h < hexes.size(); ++h)
     hexes.material[h] = material_of_class[static_cast<std::size_t>(im.element_class[h])];
+  int stitch_law = -1;
+  if (im.n_stitches > 0) {
+    ctx.model.bar_laws.push_back(fem::BarForceLaw::linear("cured_stitch", im.stitch_axial_stiffness,
+                                                          /*tension_only=*/true,
+                                                          im.stitch_linear_density));
+    stitch_law = static_cast<int>(ctx.model.bar_laws.size()) - 1;
+  }
   for (std::size_t p = 0; p < ctx.model.parts.size(); ++p) {
     auto& pp = ctx.model.parts[p];
+    if (ctx.part_kind[ctx.model.mesh.part_names[p]] == fem::PartKind::Bar) {
+      pp.bar_law = stitch_law;
+      ctx.part_defined[p] = 1;
+      continue;
+    }
     for (std::size_t h = 0; h < hexes.size(); ++h)
       if (static_cast<std::size_t>(hexes.part[h]) == p) {
         pp.material = hexes.material[h];
@@ -285,6 +368,18 @@ void assign_impregnated_parts(CaseReadContext& ctx, const ImpregnatedImport& im)
     pp.hourglass_stiffness = m.number("hourglass_stiffness", 1.0, Range::closed(0, 10));
     pp.hourglass_viscosity = m.number("hourglass_viscosity", 0.05, Range::closed(0, 1));
     ctx.part_defined[p] = 1;
+  }
+
+  // The cured stitch: its nodes tied to the nearest outer face of the tows.
+  if (!im.stitch_nodes.empty()) {
+    fem::TiedContactConfig c;
+    c.name = "tie_stitch";
+    c.slave_nodes = im.stitch_nodes;
+    c.master_faces = outer_hex_faces(ctx.model.mesh);
+    c.search_distance = 1.01 * im.stitch_capture;  // the transfer's capture, with round-off
+    c.source_file = ctx.file;
+    c.key_path = m.path() + ".source";
+    ctx.model.contacts.push_back(std::make_unique<fem::TiedContact>(std::move(c)));
   }
 
   // Resin bonds: a cohesive tied contact per interface that has its table.

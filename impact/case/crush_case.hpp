@@ -40,6 +40,12 @@ struct ImpregnatedImport {
   std::vector<ImpregnatedClass> classes;
   std::vector<std::string> interfaces;               // tie interface names (interply, intraply)
   std::vector<std::vector<fem::TiedFacePair>> ties;  // per interface
+  /// Kept stitches (the transfer's bars): one tension-only linear law for the cured yarn.
+  std::size_t n_stitches = 0;
+  double stitch_axial_stiffness = 0;       // N (E A)
+  double stitch_linear_density = 0;        // kg/m
+  double stitch_capture = 0;               // m, how far from a tow face a stitch node may lie
+  std::vector<std::int32_t> stitch_nodes;  // mesh nodes of the stitches (tied to the tow faces)
 };
 
 /// Whether the case has a [model] section (a crush of an imported model).

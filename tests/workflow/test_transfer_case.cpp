@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "fem/io/stage_handoff.hpp"
@@ -97,6 +98,93 @@ TEST(CliTransfer, FlatBlanketMapsEveryTowWithItsFrameVfAndTies) {
   }
   EXPECT_EQ(run_cli({"export", (f.dir / "drape").string(), "--format", "abaqus"}).code, 2)
       << "a drape run is not a transfer run";
+}
+
+// Kept stitches (`[stitches] keep = true`): each drape stitch bar beside the kept tows stays a
+// bar, its nodes where the drape left them (the same length), carrying the cured yarn's constants
+// to the crush, which ties every stitch node to the nearest tow face, and to the decks (T3D2 /
+// cable elements beside the hexahedra).
+TEST(CliTransfer, KeptStitchesBecomeBarsBetweenTowNodes) {
+  Fixture f;
+  const fs::path tc = f.dir / "transfer_stitched.toml", out = f.dir / "transfer_stitched";
+  std::ofstream(tc) << kTransfer << "[stitches]\nkeep = true\n";
+  const auto r = run_cli({"run", tc.string(), "-o", out.string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+  const auto drape = nlohmann::json::parse(slurp(f.dir / "drape" / "summary.json"));
+  const std::size_t hexes = drape["elements"]["hex8"], bars = drape["elements"]["bar2"];
+  const std::size_t kept = s["stitches_kept"];
+  ASSERT_GT(bars, 0u);
+  EXPECT_EQ(kept + s["stitches_dropped"].get<std::size_t>(), bars);
+  // On the flat blanket the stitches lie on the tows, but for a few at the corners, where the
+  // generator dropped the tows too short to hold a stitch.
+  EXPECT_GT(kept, bars * 95 / 100) << r.output;
+
+  const auto model = fem::io::read_last_frame(out / "results.h5");
+  const auto source = fem::io::read_last_frame(f.dir / "drape" / "results.h5");
+  ASSERT_EQ(model.mesh.n_bar(), kept);
+  ASSERT_EQ(model.mesh.n_hex(), hexes);
+  std::vector<char> hex_node(model.n_points(), 0);
+  for (auto n : model.mesh.hex8) hex_node[static_cast<std::size_t>(n)] = 1;
+  auto length = [](const fem::io::StageFrame& fr, std::size_t b) {
+    double d2 = 0;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const double d = fr.coordinates[3 * static_cast<std::size_t>(fr.mesh.bar2[2 * b + 1]) + c] -
+                       fr.coordinates[3 * static_cast<std::size_t>(fr.mesh.bar2[2 * b]) + c];
+      d2 += d * d;
+    }
+    return std::sqrt(d2);
+  };
+  std::map<std::int64_t, std::size_t> source_bar;
+  for (std::size_t b = 0; b < source.mesh.n_bar(); ++b) source_bar[source.mesh.bar_user_id[b]] = b;
+  for (std::size_t b = 0; b < kept; ++b) {
+    EXPECT_FALSE(hex_node[static_cast<std::size_t>(model.mesh.bar2[2 * b])] ||
+                 hex_node[static_cast<std::size_t>(model.mesh.bar2[2 * b + 1])])
+        << "bar " << b << ": the stitch nodes stay nodes of their own";
+    const auto it = source_bar.find(model.mesh.bar_user_id[b]);
+    ASSERT_NE(it, source_bar.end()) << "bar " << b << " is no stitch of the drape";
+    EXPECT_NEAR(length(model, b), length(source, it->second), 1e-12) << b;
+  }
+  const auto* E = model.field("stitch_modulus_Pa");
+  const auto* A = model.field("stitch_area_m2");
+  ASSERT_TRUE(E && A);
+  EXPECT_DOUBLE_EQ(E->values[hexes], 10e9);
+  EXPECT_NEAR(A->values[hexes], 7.6e-6 / 1380, 1e-15);
+  EXPECT_TRUE(std::isnan(E->values[0])) << "a hexahedron has no yarn modulus";
+
+  for (const std::string format : {"abaqus", "lsdyna"}) {
+    const auto e = run_cli({"export", out.string(), "--format", format});
+    ASSERT_EQ(e.code, 0) << e.output;
+    const auto deck = transfer::read_deck(
+        out / (format == "abaqus" ? "impregnated.inp" : "impregnated.k"), format);
+    EXPECT_EQ(deck.bars, kept) << format;
+    EXPECT_EQ(deck.elements, hexes + kept) << format;
+    EXPECT_EQ(deck.materials, s["material_classes"].get<std::size_t>() + 1) << format;
+  }
+
+  // The crush builds the bars with the cured yarn's tension-only law and ties every stitch node
+  // to a tow face; pressed, it keeps its energy balance.
+  const fs::path crush = f.dir / "crush";
+  const auto c = run_cli({"run",   (kSource / "cases/hemisphere/crush.toml").string(),
+                          "-o",    crush.string(),
+                          "--set", "model.source=" + (out / "results.h5").string(),
+                          "--set", "model.damage.fracture_energy.fibre_tension=300000.0",
+                          "--set", "model.damage.fracture_energy.fibre_compression=110000.0",
+                          "--set", "model.damage.fracture_energy.matrix_tension=1400.0",
+                          "--set", "model.damage.fracture_energy.transverse_shear=1600.0",
+                          "--set", "tool[0].point=[0.03,0.03,0.02551]",
+                          "--set", "tool[0].ramp_time=1e-6",
+                          "--set", "tool[1].point=[0.0,0.0,-1e-5]",
+                          "--set", "time.end_time=1e-4",
+                          "--set", "time.quasi_static_from=5e-5",
+                          "--set", "output.figures=false",
+                          "--set", "output.report=false"});
+  ASSERT_EQ(c.code, 0) << c.output;
+  const auto cs = nlohmann::json::parse(slurp(crush / "summary.json"));
+  EXPECT_EQ(cs["elements"]["bar2"].get<std::size_t>(), kept);
+  EXPECT_LT(cs["energy_balance_error"].get<double>(), 0.01);
+  EXPECT_NE(c.output.find("stitch nodes tied to the nearest tow face"), std::string::npos);
+  EXPECT_NE(c.output.find("(0 beside no face: free)"), std::string::npos) << c.output;
 }
 
 TEST(CliTransfer, BadInputNamesTheKey) {

@@ -100,6 +100,14 @@ TransferCase load_transfer_case(const std::filesystem::path& file,
     spec.ties.shear_strength =
         t->number("shear_strength", spec.ties.shear_strength, Range::positive());
   }
+  if (auto t = root.table("stitches")) {
+    auto& st = spec.stitches;
+    st.keep = t->boolean("keep", false);
+    st.capture_distance = t->number("capture_distance", 0.0, Range::non_negative());
+    st.modulus = t->number("modulus", st.modulus, Range::positive());
+    st.linear_density = t->number("linear_density", st.linear_density, Range::positive());
+    st.density = t->number("density", st.density, Range::positive());
+  }
   if (auto o = root.table("output")) {
     tc.frames_xdmf = o->choice("frames", {"xdmf", "none"}, "xdmf") == "xdmf";
     tc.figures = o->boolean("figures", true);

@@ -68,6 +68,20 @@ ExportResult export_impregnated(const std::filesystem::path& dir, const std::str
     element_of[mesh.hex_user_id.empty() ? static_cast<std::int64_t>(e + 1) : mesh.hex_user_id[e]] =
         static_cast<std::int32_t>(e);
   }
+  // Kept stitches: bars with the yarn's constants as cell fields (after the hexahedra).
+  if (const std::size_t nb = mesh.n_bar(); nb > 0) {
+    const fem::io::FrameField* f[3] = {frame.field("stitch_modulus_Pa"),
+                                       frame.field("stitch_area_m2"), frame.field("density_kg_m3")};
+    for (const auto* x : f)
+      if (!x || x->n_components != 1 || x->values.size() != n + nb)
+        throw InputError(dir.string(), "",
+                         "results.h5 has stitch bars without the yarn's constants");
+    auto& st = m.stitches;
+    st.modulus = f[0]->values[n], st.area = f[1]->values[n], st.density = f[2]->values[n];
+    for (std::size_t b = 0; b < nb; ++b)
+      st.bars.push_back({static_cast<std::int32_t>(mesh.bar2[2 * b]),
+                         static_cast<std::int32_t>(mesh.bar2[2 * b + 1])});
+  }
   const CsvTable mat = read_csv(dir / "materials.csv");
   const auto vf = mat.column("vf"), rho = mat.column("density_kg_m3");
   const char* names[9] = {"E1_Pa", "E2_Pa",  "E3_Pa",  "nu12",  "nu13",
@@ -113,6 +127,7 @@ ExportResult export_impregnated(const std::filesystem::path& dir, const std::str
     transfer::write_lsdyna_keyword(r.file, m);
   r.nodes = m.nodes.size();
   r.elements = m.hex.size();
+  r.bars = m.stitches.bars.size();
   r.materials = m.materials.size();
   r.tie_pairs = pairs;
   return r;

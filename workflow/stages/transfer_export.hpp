@@ -10,6 +10,7 @@ namespace ncfsim::workflow {
 struct ExportResult {
   std::filesystem::path file;
   std::size_t nodes = 0, elements = 0, materials = 0, tie_pairs = 0;
+  std::size_t bars = 0;  // kept stitches (not in elements)
 };
 
 /// Throws InputError (file = the folder) when the folder holds no completed transfer run or the

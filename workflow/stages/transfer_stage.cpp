@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "fem/errors.hpp"
@@ -64,7 +65,9 @@ ImpregnatedModel build(transfer::TransferCase& tc, const fem::io::StageFrame& fr
   return m;
 }
 
-void write_results(const std::filesystem::path& dir, const ImpregnatedModel& m) {
+void write_results(const std::filesystem::path& dir, const ImpregnatedModel& m,
+                   const transfer::StitchSpec& stitch) {
+  // The kept stitches' nodes are the last points: the tows' node fields are unchanged.
   fem::io::ResultMesh rm;
   rm.points = m.points;
   for (const auto& h : m.hex)
@@ -78,16 +81,22 @@ void write_results(const std::filesystem::path& dir, const ImpregnatedModel& m) 
     rm.material_names.push_back(fmt::format("tow_vf_{:.3f}", c.fibre_volume_fraction));
   rm.hex_ply = m.hex_ply;
   rm.hex_tow = m.hex_tow;
+  for (const auto& b : m.stitch) rm.bar2.insert(rm.bar2.end(), {b[0], b[1]});
+  rm.bar_part = m.stitch_part;
+  rm.bar_user_id = m.stitch_user_id;
+  rm.bar_material.assign(m.stitch.size(), -1);
   fem::io::Frame fr;
   fr.displacement.assign(m.points.size(), 0.0);
-  const std::size_t n = m.n_elements();
+  // Cell fields hold the hexahedra, then the kept stitch bars (NaN where a kind lacks one).
+  const std::size_t n = m.n_elements(), nb = m.stitch.size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   auto scalar = [&](const std::string& name, auto value_of) {
-    fem::io::FrameField f{name, true, 1, std::vector<double>(n)};
+    fem::io::FrameField f{name, true, 1, std::vector<double>(n + nb, nan)};
     for (std::size_t e = 0; e < n; ++e) f.values[e] = value_of(e);
     fr.fields.push_back(std::move(f));
   };
   auto axis = [&](const std::string& name, int col) {
-    fem::io::FrameField f{name, true, 3, std::vector<double>(3 * n)};
+    fem::io::FrameField f{name, true, 3, std::vector<double>(3 * (n + nb), nan)};
     for (std::size_t e = 0; e < n; ++e)
       for (int r = 0; r < 3; ++r)
         f.values[3 * e + static_cast<std::size_t>(r)] =
@@ -121,6 +130,21 @@ void write_results(const std::filesystem::path& dir, const ImpregnatedModel& m) 
   scalar("Yc_Pa", [&](std::size_t e) { return cls(e).strength.Yc; });
   scalar("S12_Pa", [&](std::size_t e) { return cls(e).strength.S12; });
   scalar("S23_Pa", [&](std::size_t e) { return cls(e).strength.S23; });
+  if (nb > 0) {  // the cured yarn: the crush and the decks take its law from here
+    auto bar = [&](const std::string& name, double value) {
+      auto it = std::find_if(fr.fields.begin(), fr.fields.end(),
+                             [&](const auto& f) { return f.name == name; });
+      if (it == fr.fields.end()) {
+        fr.fields.push_back({name, true, 1, std::vector<double>(n + nb, nan)});
+        it = fr.fields.end() - 1;
+      }
+      std::fill(it->values.begin() + static_cast<std::ptrdiff_t>(n), it->values.end(), value);
+    };
+    bar("density_kg_m3", stitch.density);
+    bar("stitch_modulus_Pa", stitch.modulus);
+    bar("stitch_area_m2", stitch.area());
+    bar("stitch_capture_m", m.stitch_capture);
+  }
   fem::io::XdmfResultWriter w(dir, rm);
   w.write_frame(fr);
   w.close();
@@ -232,9 +256,16 @@ int run_transfer_stage(const StageCall& call) {
   double vf_min = 1, vf_max = 0, vf_sum = 0;
   for (double vf : m.vf) vf_min = std::min(vf_min, vf), vf_max = std::max(vf_max, vf), vf_sum += vf;
   const double vf_mean = vf_sum / static_cast<double>(m.vf.size());
-  log->info("{} of {} tow hexahedra mapped ({} trimmed at {} m, {} lost), {} stitch bars dropped",
-            m.n_elements(), m.n_candidates, m.n_trimmed, tc.spec.trim.radius, m.n_lost,
-            m.n_stitches);
+  log->info("{} of {} tow hexahedra mapped ({} trimmed at {} m, {} lost)", m.n_elements(),
+            m.n_candidates, m.n_trimmed, tc.spec.trim.radius, m.n_lost);
+  if (tc.spec.stitches.keep)
+    log->info(
+        "stitches kept: {} of {} bars with {} nodes, to be tied to the tow faces within {:.4g} m "
+        "({} with an end beside no kept tow: dropped); yarn E {:.4g} Pa, area {:.4g} m^2",
+        m.stitch.size(), m.n_stitches, m.n_stitch_nodes, m.stitch_capture, m.n_stitches_uncaptured,
+        tc.spec.stitches.modulus, tc.spec.stitches.area());
+  else
+    log->info("{} stitch bars dropped (stitches.keep = false)", m.n_stitches);
   log->info(
       "Vf {:.4f} .. {:.4f}, mean {:.4f} ({} capped at the locking value {:.4f}, {} spread tows "
       "raised to "
@@ -250,7 +281,7 @@ int run_transfer_stage(const StageCall& call) {
         m.n_lost, m.n_eroded, m.n_distorted, tc.spec.min_corner_jacobian,
         m.n_lost - m.n_eroded - m.n_distorted);
 
-  if (tc.frames_xdmf) write_results(dir, m);
+  if (tc.frames_xdmf) write_results(dir, m, tc.spec.stitches);
   write_file_atomically(dir / "materials.csv", materials_csv(m));
   write_file_atomically(dir / "ties.csv", ties_csv(m));
   write_file_atomically(dir / "vf_histogram.csv", vf_histogram_csv(m, tc.spec.mapping));
@@ -274,8 +305,8 @@ int run_transfer_stage(const StageCall& call) {
   for (const auto& t : m.ties) s["tie_pairs_" + t.name] = t.slave.size();
   s["tie_normal_strength_Pa"] = tc.spec.ties.normal_strength;
   s["tie_shear_strength_Pa"] = tc.spec.ties.shear_strength;
-  s["stitches_kept"] = 0;
-  s["stitches_dropped"] = m.n_stitches;
+  s["stitches_kept"] = m.stitch.size();
+  s["stitches_dropped"] = m.n_stitches - m.stitch.size();
   s["compressive_ratio"] = tc.spec.compressive_ratio;
   s["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_file_atomically(dir / "summary.json", s.dump(2) + "\n");
