@@ -636,8 +636,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       const V3v e2 = in2 * w;
       const V3v e3 = cross(e1, e2);
       const VD R[9] = {e1.x, e2.x, e3.x, e1.y, e2.y, e3.y, e1.z, e2.z, e3.z};
-      // Deformation gradient F = J J_ref^{-1}, Green-Lagrange strain in the reference material
-      // axes M: E_mat = M^T (F^T F - I) M / 2. The material sees exact increments of E_mat.
+      // Deformation gradient F = J J_ref^{-1} in the reference material axes M (FM); its C
+      // bounds the directional step.
       const VD J[9] = {a[1].x, a[2].x, a[3].x, a[1].y, a[2].y, a[3].y, a[1].z, a[2].z, a[3].z};
       VD JM[9], FM[9];
       for (int k = 0; k < 9; ++k) JM[k] = load(jm + k * n + e, cnt);
@@ -650,10 +650,64 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       const VD C12 = FM[0] * FM[1] + FM[3] * FM[4] + FM[6] * FM[7];
       const VD C23 = FM[1] * FM[2] + FM[4] * FM[5] + FM[7] * FM[8];
       const VD C13 = FM[0] * FM[2] + FM[3] * FM[5] + FM[6] * FM[8];
-      const VD Enew[6] = {0.5 * (C11 - 1.0), 0.5 * (C22 - 1.0), 0.5 * (C33 - 1.0), C12, C23, C13};
-      for (int c = 0; c < 6; ++c) {
-        store_a(&deps[c][j], Enew[c] - load(strain + c * n + e, cnt));
-        store_a(&sig_old[c][j], load(stress + c * n + e, cnt));
+      // Green-Lagrange strain increment in the material axes, from the rate of deformation of
+      // the uniform-gradient operator that makes the nodal forces: dE = (FM)^T sym(Lbar) (FM) dt,
+      // both at the mid-step shape x - v dt/2. Then V0 S : dE = V sigma : Lbar dt, the work the
+      // nodal forces do, on distorted elements too (dE from the centre F alone differs from it by
+      // V sigma : (Lbar - L_centre), work no one books); and a rigid rotation gives dE = 0
+      // exactly (the mid-step gradient of a rotation increment is skew).
+      {
+        const VD hdt = 0.5 * dt;
+        V3v am[7];
+        for (int k = 1; k < 7; ++k) am[k] = a[k] - hdt * vh[k];
+        V3v dm[7];
+        dm[1] = cross(am[2], am[3]) + third * cross(a[6] - hdt * vh[6], am[5]);
+        dm[2] = cross(am[3], am[1]) + third * cross(am[4], a[6] - hdt * vh[6]);
+        dm[3] = cross(am[1], am[2]) + third * cross(am[5], am[4]);
+        dm[4] = third * (cross(a[6] - hdt * vh[6], am[2]) + cross(am[3], am[5]));
+        dm[5] = third * (cross(am[4], am[3]) + cross(am[1], a[6] - hdt * vh[6]));
+        dm[6] = third * (cross(am[2], am[4]) + cross(am[5], am[1]));
+        VD sm = 0.0;
+        for (int k = 1; k < 7; ++k) sm += dot(am[k], dm[k]);
+        const VD f8Vm = 3.0 / sm;  // 8 / V at mid-step, V = 8/3 sum a_k . d_k
+        VD Lm[9];
+        Lm[0] = vh[1].x * dm[1].x, Lm[1] = vh[1].x * dm[1].y, Lm[2] = vh[1].x * dm[1].z;
+        Lm[3] = vh[1].y * dm[1].x, Lm[4] = vh[1].y * dm[1].y, Lm[5] = vh[1].y * dm[1].z;
+        Lm[6] = vh[1].z * dm[1].x, Lm[7] = vh[1].z * dm[1].y, Lm[8] = vh[1].z * dm[1].z;
+        for (int k = 2; k < 7; ++k) {
+          Lm[0] += vh[k].x * dm[k].x, Lm[1] += vh[k].x * dm[k].y, Lm[2] += vh[k].x * dm[k].z;
+          Lm[3] += vh[k].y * dm[k].x, Lm[4] += vh[k].y * dm[k].y, Lm[5] += vh[k].y * dm[k].z;
+          Lm[6] += vh[k].z * dm[k].x, Lm[7] += vh[k].z * dm[k].y, Lm[8] += vh[k].z * dm[k].z;
+        }
+        const VD g = dt * f8Vm;
+        const VD D[9] = {g * Lm[0],
+                         0.5 * g * (Lm[1] + Lm[3]),
+                         0.5 * g * (Lm[2] + Lm[6]),
+                         0.5 * g * (Lm[1] + Lm[3]),
+                         g * Lm[4],
+                         0.5 * g * (Lm[5] + Lm[7]),
+                         0.5 * g * (Lm[2] + Lm[6]),
+                         0.5 * g * (Lm[5] + Lm[7]),
+                         g * Lm[8]};
+        const VD Jm[9] = {am[1].x, am[2].x, am[3].x, am[1].y, am[2].y,
+                          am[3].y, am[1].z, am[2].z, am[3].z};
+        VD Fm[9];
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            Fm[3 * r + c] =
+                Jm[3 * r] * JM[c] + Jm[3 * r + 1] * JM[3 + c] + Jm[3 * r + 2] * JM[6 + c];
+        VD DF[9];  // D (FM)
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            DF[3 * r + c] = D[3 * r] * Fm[c] + D[3 * r + 1] * Fm[3 + c] + D[3 * r + 2] * Fm[6 + c];
+        auto G = [&](int r, int c) {  // ((FM)^T D (FM))_rc
+          return Fm[r] * DF[c] + Fm[3 + r] * DF[3 + c] + Fm[6 + r] * DF[6 + c];
+        };
+        const VD dE[6] = {G(0, 0), G(1, 1), G(2, 2), 2.0 * G(0, 1), 2.0 * G(1, 2), 2.0 * G(0, 2)};
+        for (int c = 0; c < 6; ++c) {
+          store_a(&deps[c][j], dE[c]);
+          store_a(&sig_old[c][j], load(stress + c * n + e, cnt));
+        }
       }
       for (int k = 0; k < 9; ++k) store_a(&Qm[k][j], FM[k]), store_a(&Rm[k][j], R[k]);
       // Hourglass rates q_alpha = vhat_{3+alpha} - L a_{3+alpha}, then into the element frame.

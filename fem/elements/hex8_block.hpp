@@ -4,9 +4,11 @@
 // Formulation (see docs/theory.md):
 //  * uniform-gradient (Flanagan-Belytschko) B operator, b_I = dV/dx_I / V, exact volume, so the
 //    patch test holds on distorted meshes;
-//  * objective total-Lagrangian stress at the centre: Green-Lagrange strain from the deformation
-//    gradient F in the reference material axes, 2nd Piola-Kirchhoff stress from the material,
-//    pushed forward to Cauchy stress; fibre axes convect with F, rotations are exact, no drift;
+//  * objective Lagrangian stress at the centre: Green-Lagrange strain in the reference material
+//    axes advanced by the uniform gradient's rate of deformation pulled back with the mid-step F
+//    (so the booked energy is the nodal forces' work, distorted elements too), 2nd
+//    Piola-Kirchhoff stress from the material, pushed forward to Cauchy stress; fibre axes
+//    convect with F, rigid rotations add no strain;
 //  * physically based, assumed-strain hourglass stabilisation in the element frame: each
 //    hourglass mode is resisted by the energy of its linear (bending) or bilinear strain field,
 //    with the parasitic shear of bending removed (Belytschko-Bindeman type). One element through

@@ -140,7 +140,6 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   const std::vector<std::string> crush_args = {
       "run",   (kSource / "cases/hemisphere/ci/crush.toml").string(),
       "--set", "model.source=" + (dome / "results.h5").string(),
-      "--set", "time.energy_balance_limit=0.15",
       "--set", "output.figures=false",
       "--set", "output.report=false"};
   auto with = [&](std::vector<std::string> extra) {
@@ -156,8 +155,10 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   EXPECT_LT(cs["peak_force_N"].get<double>(), 5000.0);
   EXPECT_GT(cs["energy_absorbed_J"].get<double>(), 0.0);
   EXPECT_GT(cs["stroke_at_peak_m"].get<double>(), 0.0);
-  // The goal is 5 %; this session's run closed at 4.4 % (docs/fabric-data.md, "Crush").
-  EXPECT_LT(cs["energy_balance_error"].get<double>(), 0.10);
+  // The limit is 5 %, including erosion; it closes at 0.001 % (docs/fabric-data.md, "Crush":
+  // 5.6 % before the hexahedron booked the work of its uniform-gradient forces).
+  EXPECT_LT(cs["energy_balance_error"].get<double>(), 0.05);
+  EXPECT_LT(cs["energy_balance_error_max"].get<double>(), 0.05);
   EXPECT_LT(cs["punch_max_penetration_m"].get<double>(), 0.1 * 0.23e-3) << "the punch sinks in";
   double failed = 0;
   for (const char* m : {"fibre_tension", "fibre_compression", "matrix_tension",

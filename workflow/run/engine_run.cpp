@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <map>
 
 #include "fem/errors.hpp"
 #include "fem/io/result_writers.hpp"
@@ -86,7 +87,19 @@ struct Run {
   Clock::time_point wall0;
   json summary;
   std::string status = "completed", failure;
-  double max_error = 0;  // energy balance error over the run after its first 5 %
+  // Largest energy-balance error per decade of the energy in play so far (scale_max): the
+  // summary's maximum skips the decades far below the run's largest energy, where the residual
+  // is round-off on next to nothing (a model at rest before the tool arrives).
+  std::map<int, double> max_error_by_decade;
+  double max_error() const {
+    if (max_error_by_decade.empty()) return 0.0;
+    const int top = max_error_by_decade.rbegin()->first;
+    double m = 0;
+    for (const auto& [decade, err] : max_error_by_decade)
+      if (decade >= top - kBalanceDecades) m = std::max(m, err);
+    return m;
+  }
+  static constexpr int kBalanceDecades = 3;
   double ke_ie_max =
       0;  // kinetic / internal energy at the history rows from time.quasi_static_from
   bool ke_ie_exceeded = false;
@@ -125,7 +138,7 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
   r.summary["wall_seconds"] = seconds_since(r.wall0);
   r.summary["frames"] = frames.written();
   r.summary["frame_write_errors"] = frames.errors();
-  add_state_summary(s, r.max_error, r.summary);
+  add_state_summary(s, r.max_error(), r.summary);
   r.summary["kinetic_to_internal_from_s"] = r.ec.model.time.quasi_static_from;
   r.summary["kinetic_to_internal_max"] = r.ke_ie_max;
   r.summary["kinetic_to_internal_end"] =
@@ -204,10 +217,13 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
       solver.step([&] {
         const double t = solver.time();
         log_erosions(solver, measures, erosions_logged, *r.log);
-        const double err = solver.energy().error();
-        if (t > 0.05 * tc.end_time)
-          r.max_error =
-              std::max(r.max_error, err);  // skip the start, when little energy is in play
+        const auto& balance = solver.energy();
+        const double err = balance.error();
+        if (balance.scale_max > fem::kEnergyScaleFloor) {
+          double& m =
+              r.max_error_by_decade[static_cast<int>(std::floor(std::log10(balance.scale_max)))];
+          m = std::max(m, err);
+        }
         if (t >= next_history) {
           history.write_row(solver);
           next_history += tc.history_interval;
