@@ -481,6 +481,18 @@ inline void basis_transpose(const VD w[8], VD f[8]) {
   f[4] = P0 + M0, f[5] = P1 + M1, f[6] = P2 + M2, f[7] = P3 + M3;
 }
 
+// M = sum_{k=1..6} u_k (x) w_k, row-major (a velocity gradient times V/8).
+inline void sum_outer(const V3v* u, const V3v* w, VD (&M)[9]) {
+  M[0] = u[1].x * w[1].x, M[1] = u[1].x * w[1].y, M[2] = u[1].x * w[1].z;
+  M[3] = u[1].y * w[1].x, M[4] = u[1].y * w[1].y, M[5] = u[1].y * w[1].z;
+  M[6] = u[1].z * w[1].x, M[7] = u[1].z * w[1].y, M[8] = u[1].z * w[1].z;
+  for (int k = 2; k < 7; ++k) {
+    M[0] += u[k].x * w[k].x, M[1] += u[k].x * w[k].y, M[2] += u[k].x * w[k].z;
+    M[3] += u[k].y * w[k].x, M[4] += u[k].y * w[k].y, M[5] += u[k].y * w[k].z;
+    M[6] += u[k].z * w[k].x, M[7] += u[k].z * w[k].y, M[8] += u[k].z * w[k].z;
+  }
+}
+
 }  // namespace
 
 void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double dt, double* f,
@@ -619,14 +631,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       const VD iV = 1.0 / V;
       const VD f8V = 8.0 * iV;
       VD L[9];
-      L[0] = vh[1].x * d[1].x, L[1] = vh[1].x * d[1].y, L[2] = vh[1].x * d[1].z;
-      L[3] = vh[1].y * d[1].x, L[4] = vh[1].y * d[1].y, L[5] = vh[1].y * d[1].z;
-      L[6] = vh[1].z * d[1].x, L[7] = vh[1].z * d[1].y, L[8] = vh[1].z * d[1].z;
-      for (int k = 2; k < 7; ++k) {
-        L[0] += vh[k].x * d[k].x, L[1] += vh[k].x * d[k].y, L[2] += vh[k].x * d[k].z;
-        L[3] += vh[k].y * d[k].x, L[4] += vh[k].y * d[k].y, L[5] += vh[k].y * d[k].z;
-        L[6] += vh[k].z * d[k].x, L[7] += vh[k].z * d[k].y, L[8] += vh[k].z * d[k].z;
-      }
+      sum_outer(vh, d, L);
       for (VD& l : L) l *= f8V;
       // Element frame: e1 along a1, e2 in the a1-a2 plane, e3 normal; half lengths.
       const VD in1 = 1.0 / stdx::sqrt(dot(a[1], a[1]));
@@ -671,14 +676,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
         for (int k = 1; k < 7; ++k) sm += dot(am[k], dm[k]);
         const VD f8Vm = 3.0 / sm;  // 8 / V at mid-step, V = 8/3 sum a_k . d_k
         VD Lm[9];
-        Lm[0] = vh[1].x * dm[1].x, Lm[1] = vh[1].x * dm[1].y, Lm[2] = vh[1].x * dm[1].z;
-        Lm[3] = vh[1].y * dm[1].x, Lm[4] = vh[1].y * dm[1].y, Lm[5] = vh[1].y * dm[1].z;
-        Lm[6] = vh[1].z * dm[1].x, Lm[7] = vh[1].z * dm[1].y, Lm[8] = vh[1].z * dm[1].z;
-        for (int k = 2; k < 7; ++k) {
-          Lm[0] += vh[k].x * dm[k].x, Lm[1] += vh[k].x * dm[k].y, Lm[2] += vh[k].x * dm[k].z;
-          Lm[3] += vh[k].y * dm[k].x, Lm[4] += vh[k].y * dm[k].y, Lm[5] += vh[k].y * dm[k].z;
-          Lm[6] += vh[k].z * dm[k].x, Lm[7] += vh[k].z * dm[k].y, Lm[8] += vh[k].z * dm[k].z;
-        }
+        sum_outer(vh, dm, Lm);
         const VD g = dt * f8Vm;
         const VD D[9] = {g * Lm[0],
                          0.5 * g * (Lm[1] + Lm[3]),

@@ -184,21 +184,21 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
   // locality order: kept, no renumbering).
   fem::Mesh& mesh = ctx.model.mesh;
   std::vector<std::int32_t> node_of(rm.n_points(), -1);
+  auto node = [&](std::int64_t point) {  // the mesh node of a result point, made on first use
+    const auto p = static_cast<std::size_t>(point);
+    if (node_of[p] < 0) {
+      node_of[p] = static_cast<std::int32_t>(mesh.n_nodes());
+      for (std::size_t c = 0; c < 3; ++c) mesh.coords.push_back(rm.points[3 * p + c]);
+      mesh.node_user_id.push_back(rm.node_user_id.empty() ? static_cast<std::int64_t>(p + 1)
+                                                          : rm.node_user_id[p]);
+    }
+    return node_of[p];
+  };
   fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
   for (const auto& name : rm.part_names) mesh.add_part(name);
   for (std::size_t h = 0; h < nh; ++h) {
     std::int32_t nodes[8];
-    for (std::size_t I = 0; I < 8; ++I) {
-      const auto p = static_cast<std::size_t>(rm.hex8[8 * h + I]);
-      if (node_of[p] < 0) {
-        node_of[p] = static_cast<std::int32_t>(mesh.n_nodes());
-        for (int c = 0; c < 3; ++c)
-          mesh.coords.push_back(rm.points[3 * p + static_cast<std::size_t>(c)]);
-        mesh.node_user_id.push_back(rm.node_user_id.empty() ? static_cast<std::int64_t>(p + 1)
-                                                            : rm.node_user_id[p]);
-      }
-      nodes[I] = node_of[p];
-    }
+    for (std::size_t I = 0; I < 8; ++I) nodes[I] = node(rm.hex8[8 * h + I]);
     hexes.add(std::span<const std::int32_t>(nodes, 8), rm.hex_part[h]);
     hexes.user_id.push_back(rm.hex_user_id.empty() ? static_cast<std::int64_t>(h + 1)
                                                    : rm.hex_user_id[h]);
@@ -250,18 +250,8 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
     const std::size_t first_stitch_node = mesh.n_nodes();
     fem::ElementSet& bars = mesh.elements(fem::ElementKind::Bar2);
     for (std::size_t b = 0; b < nb; ++b) {
-      std::int32_t nodes[2];
-      for (std::size_t I = 0; I < 2; ++I) {
-        const auto p = static_cast<std::size_t>(rm.bar2[2 * b + I]);
-        if (node_of[p] < 0) {  // a stitch node: tied to the tows in assign_impregnated_parts
-          node_of[p] = static_cast<std::int32_t>(mesh.n_nodes());
-          for (int c = 0; c < 3; ++c)
-            mesh.coords.push_back(rm.points[3 * p + static_cast<std::size_t>(c)]);
-          mesh.node_user_id.push_back(rm.node_user_id.empty() ? static_cast<std::int64_t>(p + 1)
-                                                              : rm.node_user_id[p]);
-        }
-        nodes[I] = node_of[p];
-      }
+      // Stitch nodes are new nodes, tied to the tows in assign_impregnated_parts.
+      const std::int32_t nodes[2] = {node(rm.bar2[2 * b]), node(rm.bar2[2 * b + 1])};
       bars.add(std::span<const std::int32_t>(nodes, 2), rm.bar_part[b]);
       bars.user_id.push_back(rm.bar_user_id.empty() ? static_cast<std::int64_t>(b + 1)
                                                     : rm.bar_user_id[b]);
