@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <spdlog/logger.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <cmath>
@@ -109,6 +110,12 @@ struct Run {
   }
 };
 
+// The process's largest resident set so far (what a user sizes a machine by), MB.
+double peak_memory_mb() {
+  rusage u{};
+  return getrusage(RUSAGE_SELF, &u) == 0 ? static_cast<double>(u.ru_maxrss) / 1024.0 : 0.0;
+}
+
 void log_start(const Run& r) {
   r.log->info("ncfsim {} | case '{}' ({}) | resolution {}", kVersion, r.ec.name, r.ec.file.string(),
               r.ec.resolution);
@@ -136,6 +143,7 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
                   const RunHistory& history, const FrameOutput& frames) {
   r.summary["status"] = r.status;
   r.summary["wall_seconds"] = seconds_since(r.wall0);
+  r.summary["peak_memory_MB"] = peak_memory_mb();
   r.summary["frames"] = frames.written();
   r.summary["frame_write_errors"] = frames.errors();
   add_state_summary(s, r.max_error(), r.summary);
