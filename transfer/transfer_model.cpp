@@ -79,6 +79,19 @@ struct FaceRef {
   double radius;  // largest centre-to-corner distance
 };
 
+// The thinnest tow: the smallest distance between a hexahedron's bottom and top face centres.
+double thinnest_tow(const ImpregnatedModel& m, const std::vector<V3>& x) {
+  double thinnest = 1e300;
+  for (const auto& h : m.hex) {
+    V3 bottom, top;
+    for (std::size_t k = 0; k < 4; ++k)
+      bottom += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[0][k])])],
+          top += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[1][k])])];
+    thinnest = std::min(thinnest, norm(top - bottom));
+  }
+  return thinnest;
+}
+
 // Tied pairs: outer faces of the model's hexahedra (at positions x) facing each other across the
 // resin layer, between the plies and between neighbouring tows of a ply.
 std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>& x,
@@ -94,7 +107,6 @@ std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>
       face_of[key] = {static_cast<std::int32_t>(e), f};
     }
   std::vector<FaceRef> faces;
-  double thinnest = 1e300;
   for (const auto& [key, n] : count) {
     if (n != 1) continue;
     const auto [e, f] = face_of[key];
@@ -107,16 +119,8 @@ std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>
     double radius = 0;
     for (const auto& p : c) radius = std::max(radius, norm(p - centre));
     faces.push_back({e, f, centre, normal, radius});
-    if (f == 1) {  // the tow's thickness: top face centre to bottom face centre
-      V3 bottom;
-      for (int k = 0; k < 4; ++k)
-        bottom +=
-            0.25 * x[static_cast<std::size_t>(
-                       m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(kFace[0][k])])];
-      thinnest = std::min(thinnest, norm(centre - bottom));
-    }
   }
-  const double gap = spec.distance > 0 ? spec.distance : thinnest;
+  const double gap = spec.distance > 0 ? spec.distance : thinnest_tow(m, x);
   std::vector<double> lo(3 * faces.size()), hi(3 * faces.size());
   for (std::size_t k = 0; k < faces.size(); ++k)
     for (int d = 0; d < 3; ++d) {
@@ -162,19 +166,6 @@ std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>
   if (spec.interply) ties.push_back(std::move(inter));
   if (spec.intraply) ties.push_back(std::move(intra));
   return ties;
-}
-
-// The thinnest tow: the smallest distance between a hexahedron's bottom and top face centres.
-double thinnest_tow(const ImpregnatedModel& m, const std::vector<V3>& x) {
-  double thinnest = 1e300;
-  for (const auto& h : m.hex) {
-    V3 bottom, top;
-    for (std::size_t k = 0; k < 4; ++k)
-      bottom += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[0][k])])],
-          top += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[1][k])])];
-    thinnest = std::min(thinnest, norm(top - bottom));
-  }
-  return thinnest;
 }
 
 // Kept stitches: a drape stitch bar whose two end nodes lie within the capture distance of a

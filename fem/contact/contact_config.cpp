@@ -77,12 +77,8 @@ void validate(const TiedContactConfig& c) {
   auto key = [&](const std::string& field) { return key_of(c.key_path, c.name, field); };
   if (c.name.empty())
     throw InputError(f, from_case ? key("name") : "contact.name", "a tied contact needs a name");
-  const bool explicit_faces = !c.face_pairs.empty() || !c.slave_nodes.empty();
-  if (c.slave_nodes.empty() != c.master_faces.empty())
-    throw InputError(f, key(c.slave_nodes.empty() ? "slave_nodes" : "master_faces"),
-                     "nodes tied to faces need both the nodes and the faces");
   for (const ContactGroup* g : {&c.slave, &c.master})
-    if (g->parts.empty() && !explicit_faces)
+    if (g->parts.empty() && c.face_pairs.empty() && !(g == &c.slave && !c.slave_nodes.empty()))
       throw InputError(f,
                        key(g == &c.slave ? (from_case ? "slave_parts" : "slave")
                                          : (from_case ? "master_parts" : "master")),

@@ -70,11 +70,6 @@ struct PenaltyContactConfig {
 /// if failed surfaces must still push on each other.
 /// A slave face tied to a master face (faces of hexahedra: mesh hexahedron index, face 0..5 in
 /// kHex8Faces order), e.g. the resin bonds a transfer found between tows and plies.
-struct TiedHexFace {
-  std::int32_t hex = 0;  // index in the mesh's hexahedra
-  int face = 0;          // kHex8Faces order
-};
-
 struct TiedFacePair {
   std::int32_t slave_hex = 0, master_hex = 0;
   int slave_face = 0, master_face = 0;
@@ -102,12 +97,12 @@ struct TiedContactConfig {
   /// Explicit face pairs (non-empty: slave and master groups are not used): each node of a slave
   /// face is tied to the nearest of the master faces paired with its faces.
   std::vector<TiedFacePair> face_pairs;
-  /// Explicit nodes tied to explicit faces (LS-DYNA's TIED_NODES_TO_SURFACE; non-empty: the
-  /// groups and face_pairs are not used): each slave node to the nearest master face within
-  /// search_distance (0: the thinnest master hexahedron's thickness), e.g. the cured stitch yarn's
-  /// nodes to the tows it runs on. A node beside no face stays untied (untied_nodes()).
+  /// Explicit slave nodes (LS-DYNA's TIED_NODES_TO_SURFACE; non-empty: in place of the slave
+  /// group's surface nodes), each tied to the nearest segment of the master group's surface
+  /// within search_distance (0 here: the thinnest master hexahedron's thickness), with no
+  /// tributary area (the strengths give such a tie no limit), e.g. the cured stitch yarn's nodes
+  /// to the tows it runs on. A node beside no segment stays untied (untied_nodes()).
   std::vector<std::int32_t> slave_nodes;
-  std::vector<TiedHexFace> master_faces;
   std::string source_file;  // for messages only, may be empty
   std::string key_path;     // for messages only: the case-file table ("contact[1]"), may be empty
 };

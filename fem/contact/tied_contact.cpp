@@ -168,82 +168,6 @@ void TiedContact::initialise_face_pairs(const ContactSetup& setup) {
   }
 }
 
-void TiedContact::initialise_nodes_to_faces(const ContactSetup& setup) {
-  const std::string prefix = cfg_.key_path.empty() ? "contact." + cfg_.name : cfg_.key_path;
-  const ElementSet& hexes = setup.mesh->elements(ElementKind::Hex8);
-  const std::size_t offset = setup.mesh->element_offset(ElementKind::Hex8);
-  const double* x0 = setup.x0;
-  const std::size_t n_f = cfg_.master_faces.size();
-  std::vector<std::int32_t> corners(4 * n_f);
-  double thinnest = std::numeric_limits<double>::max();
-  for (std::size_t k = 0; k < n_f; ++k) {
-    const auto& mf = cfg_.master_faces[k];
-    if (mf.hex < 0 || static_cast<std::size_t>(mf.hex) >= hexes.size() || mf.face < 0 ||
-        mf.face > 5)
-      throw InputError(cfg_.source_file, prefix + ".master_faces",
-                       "names hexahedron " + std::to_string(mf.hex) + " face " +
-                           std::to_string(mf.face) + " outside the mesh");
-    const auto nodes = hexes.nodes(static_cast<std::size_t>(mf.hex));
-    double centre[3] = {0, 0, 0}, face_centre[3] = {0, 0, 0};
-    for (std::size_t a = 0; a < 8; ++a)
-      for (std::size_t c = 0; c < 3; ++c)
-        centre[c] += 0.125 * x0[3 * static_cast<std::size_t>(nodes[a]) + c];
-    for (std::size_t a = 0; a < 4; ++a) {
-      corners[4 * k + a] =
-          nodes[static_cast<std::size_t>(kHex8Faces[static_cast<std::size_t>(mf.face)].corner[a])];
-      for (std::size_t c = 0; c < 3; ++c)
-        face_centre[c] += 0.25 * x0[3 * static_cast<std::size_t>(corners[4 * k + a]) + c];
-    }
-    double d2 = 0;
-    for (std::size_t c = 0; c < 3; ++c)
-      d2 += (face_centre[c] - centre[c]) * (face_centre[c] - centre[c]);
-    thinnest = std::min(thinnest, 2 * std::sqrt(d2));  // the hexahedron across this face
-  }
-  const double r = cfg_.search_distance > 0 ? cfg_.search_distance : thinnest;
-  search_distance_ = r;
-  std::vector<double> lo(3 * n_f), hi(3 * n_f);
-  for (std::size_t k = 0; k < n_f; ++k) {
-    double q[4][3];
-    gather_segment(x0, &corners[4 * k], q);
-    for (int c = 0; c < 3; ++c) {
-      lo[3 * k + c] = std::min({q[0][c], q[1][c], q[2][c], q[3][c]}) - r;
-      hi[3 * k + c] = std::max({q[0][c], q[1][c], q[2][c], q[3][c]}) + r;
-    }
-  }
-  BucketGrid grid;
-  grid.build(n_f, lo.data(), hi.data());
-  const double inv_dt0_sq = 1.0 / (setup.dt * setup.dt);
-  untied_ = 0;
-  for (const std::int32_t node : cfg_.slave_nodes) {
-    if (node < 0 || static_cast<std::size_t>(node) >= setup.mesh->n_nodes())
-      throw InputError(cfg_.source_file, prefix + ".slave_nodes",
-                       "names node " + std::to_string(node) + " outside the mesh");
-    const double* p = x0 + 3 * static_cast<std::size_t>(node);
-    std::int32_t b = 0, end = 0;
-    double best_d2 = r * r, bxi = 0, beta = 0;
-    std::int64_t best = -1;
-    if (grid.cell_of(p, b, end))
-      for (std::int32_t it = b; it < end; ++it) {
-        const auto k = static_cast<std::size_t>(grid.items()[it]);
-        const std::int32_t* cn = &corners[4 * k];
-        if (std::find(cn, cn + 4, node) != cn + 4) continue;
-        double xi = 0, eta = 0;
-        const double d2 = closest_on_segment(x0, cn, p, xi, eta);
-        if (d2 <= best_d2) best_d2 = d2, best = static_cast<std::int64_t>(k), bxi = xi, beta = eta;
-      }
-    if (best < 0) {
-      ++untied_;
-      continue;
-    }
-    const auto k = static_cast<std::size_t>(best);
-    // No tributary area: the strengths give such a tie no limit; it goes with its face's
-    // hexahedron when that is eroded.
-    add_tie(node, &corners[4 * k], bxi, beta,
-            static_cast<std::int32_t>(offset) + cfg_.master_faces[k].hex, 0.0, x0, setup.mass,
-            inv_dt0_sq);
-  }
-}
-
 void TiedContact::initialise(const ContactSetup& setup) {
   const std::string prefix = "contact." + cfg_.name;
   if (!setup.mesh || !setup.x0 || !setup.mass || !(setup.dt > 0))
@@ -252,14 +176,6 @@ void TiedContact::initialise(const ContactSetup& setup) {
   offset_global_.clear();
   normal_cap_.clear(), shear_cap_.clear(), seg_hex_.clear(), slave_hex_.clear(), area_.clear();
   cohesive_ = cfg_.mode_i_energy > 0;
-  if (!cfg_.slave_nodes.empty()) {
-    initialise_nodes_to_faces(setup);
-    if (node_.empty())
-      throw InputError(cfg_.source_file, prefix + ".slave_nodes",
-                       "no slave node lies within the search distance of a master face");
-    reset_tie_state();
-    return;
-  }
   if (!cfg_.face_pairs.empty()) {
     initialise_face_pairs(setup);
     if (node_.empty())
@@ -268,21 +184,27 @@ void TiedContact::initialise(const ContactSetup& setup) {
     reset_tie_state();
     return;
   }
+  // Explicit slave nodes need no slave surface: the master is then the only group.
+  const bool explicit_nodes = !cfg_.slave_nodes.empty();
   ContactGroup slave = cfg_.slave, master = cfg_.master;
   if (slave.name.empty()) slave.name = "slave";
   if (master.name.empty()) master.name = "master";
-  const ContactSurface surf =
-      extract_contact_surface(*setup.mesh, {slave, master}, setup.x0, cfg_.source_file, prefix);
+  const int master_group = explicit_nodes ? 0 : 1;
+  const ContactSurface surf = extract_contact_surface(
+      *setup.mesh,
+      explicit_nodes ? std::vector<ContactGroup>{master} : std::vector<ContactGroup>{slave, master},
+      setup.x0, cfg_.source_file, prefix);
   const double* x0 = setup.x0;
   const double* mass = setup.mass;
   std::vector<std::int32_t> master_seg;
   double t_min = std::numeric_limits<double>::max();
   for (std::size_t s = 0; s < surf.n_segments(); ++s)
-    if (surf.seg_group[s] == 1) {
+    if (surf.seg_group[s] == master_group) {
       master_seg.push_back(static_cast<std::int32_t>(s));
       t_min = std::min(t_min, surf.seg_elem_thickness[s]);
     }
-  search_distance_ = cfg_.search_distance > 0 ? cfg_.search_distance : 0.1 * t_min;
+  search_distance_ =
+      cfg_.search_distance > 0 ? cfg_.search_distance : (explicit_nodes ? 1.0 : 0.1) * t_min;
   const double r = search_distance_;
 
   // Master segments in a grid, boxes grown by the search distance.
@@ -300,12 +222,31 @@ void TiedContact::initialise(const ContactSetup& setup) {
   grid.build(n_m, lo.data(), hi.data());
 
   const double inv_dt0_sq = 1.0 / (setup.dt * setup.dt);
-  for (std::size_t e = 0; e < surf.n_nodes(); ++e) {
-    if (surf.node_group[e] != 0) continue;
-    const std::int32_t node = surf.node[e];
+  // The slave nodes: the explicit ones (no tributary area: the strengths give their ties no
+  // limit) or the slave surface's.
+  std::vector<std::int32_t> slave_nodes;
+  std::vector<double> slave_area;
+  if (explicit_nodes) {
+    for (const std::int32_t node : cfg_.slave_nodes) {
+      if (node < 0 || static_cast<std::size_t>(node) >= setup.mesh->n_nodes())
+        throw InputError(cfg_.source_file, prefix + ".slave_nodes",
+                         "names node " + std::to_string(node) + " outside the mesh");
+      slave_nodes.push_back(node), slave_area.push_back(0.0);
+    }
+  } else {
+    for (std::size_t e = 0; e < surf.n_nodes(); ++e)
+      if (surf.node_group[e] == 0)
+        slave_nodes.push_back(surf.node[e]), slave_area.push_back(surf.node_area[e]);
+  }
+  untied_ = 0;
+  for (std::size_t e = 0; e < slave_nodes.size(); ++e) {
+    const std::int32_t node = slave_nodes[e];
     const double* p = x0 + 3 * static_cast<std::size_t>(node);
     std::int32_t b = 0, end = 0;
-    if (!grid.cell_of(p, b, end)) continue;
+    if (!grid.cell_of(p, b, end)) {
+      ++untied_;
+      continue;
+    }
     double best_d2 = r * r;
     std::int32_t best = -1;
     double bxi = 0, beta = 0;
@@ -321,9 +262,12 @@ void TiedContact::initialise(const ContactSetup& setup) {
       const double d2 = closest_on_segment(x0, cn, p, xi, eta);
       if (d2 <= best_d2) best_d2 = d2, best = static_cast<std::int32_t>(s), bxi = xi, beta = eta;
     }
-    if (best < 0) continue;
+    if (best < 0) {
+      ++untied_;
+      continue;
+    }
     add_tie(node, &surf.seg_nodes[4 * static_cast<std::size_t>(best)], bxi, beta,
-            surf.seg_hex[static_cast<std::size_t>(best)], surf.node_area[e], x0, mass, inv_dt0_sq);
+            surf.seg_hex[static_cast<std::size_t>(best)], slave_area[e], x0, mass, inv_dt0_sq);
   }
   if (node_.empty())
     throw InputError(cfg_.source_file, prefix + ".search_distance",

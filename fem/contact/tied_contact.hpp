@@ -42,7 +42,7 @@ class TiedContact final : public ContactAlgorithm {
   /// Damage of each tie (0: intact, 1: separated; abrupt ties jump from 0 to 1).
   double damage(std::size_t t) const { return alive_[t] ? state_[t].damage : 1.0; }
   double search_distance() const { return search_distance_; }
-  /// Configured slave nodes (TiedContactConfig::slave_nodes) beside no master face: not tied.
+  /// Slave nodes beside no master segment (within the search distance): not tied.
   std::size_t untied_nodes() const { return untied_; }
 
  private:
@@ -50,8 +50,6 @@ class TiedContact final : public ContactAlgorithm {
   void reset_tie_state();
   /// Ties each node of the configured slave faces to the nearest of its paired master faces.
   void initialise_face_pairs(const ContactSetup& setup);
-  /// Ties each of the configured slave nodes to the nearest configured master face.
-  void initialise_nodes_to_faces(const ContactSetup& setup);
   void add_tie(std::int32_t node, const std::int32_t* corners, double xi, double eta,
                std::int32_t seg_hex, double area, const double* x0, const double* mass,
                double inv_dt0_sq);

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -11,7 +10,6 @@
 #include <stdexcept>
 
 #include "fem/contact/tied_contact.hpp"
-#include "fem/elements/element_kind.hpp"
 #include "fem/elements/hex8_block.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/stage_handoff.hpp"
@@ -116,29 +114,6 @@ const fem::io::FrameField& cell_field(const fem::io::StageFrame& fr, const std::
                                  "a transfer (`kind = \"transfer\"`)",
                                  fr.file.string(), name, components));
   return *f;
-}
-
-// Faces of the hexahedra that no other hexahedron shares (the tows' surfaces).
-std::vector<fem::TiedHexFace> outer_hex_faces(const fem::Mesh& mesh) {
-  const fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
-  std::map<std::array<std::int32_t, 4>, std::pair<int, fem::TiedHexFace>> faces;
-  for (std::size_t h = 0; h < hexes.size(); ++h) {
-    const auto nodes = hexes.nodes(h);
-    for (int f = 0; f < 6; ++f) {
-      std::array<std::int32_t, 4> key{};
-      for (std::size_t a = 0; a < 4; ++a)
-        key[a] =
-            nodes[static_cast<std::size_t>(fem::kHex8Faces[static_cast<std::size_t>(f)].corner[a])];
-      std::sort(key.begin(), key.end());
-      auto& [count, face] = faces[key];
-      ++count;
-      face = {static_cast<std::int32_t>(h), f};
-    }
-  }
-  std::vector<fem::TiedHexFace> out;
-  for (const auto& [key, cf] : faces)
-    if (cf.first == 1) out.push_back(cf.second);
-  return out;
 }
 
 }  // namespace
@@ -365,7 +340,10 @@ void assign_impregnated_parts(CaseReadContext& ctx, const ImpregnatedImport& im)
     fem::TiedContactConfig c;
     c.name = "tie_stitch";
     c.slave_nodes = im.stitch_nodes;
-    c.master_faces = outer_hex_faces(ctx.model.mesh);
+    c.master.name = "tows";
+    for (std::size_t p = 0; p < ctx.model.mesh.part_names.size(); ++p)
+      if (ctx.part_kind[ctx.model.mesh.part_names[p]] == fem::PartKind::Solid)
+        c.master.parts.push_back(static_cast<int>(p));
     c.search_distance = 1.01 * im.stitch_capture;  // the transfer's capture, with round-off
     c.source_file = ctx.file;
     c.key_path = m.path() + ".source";
