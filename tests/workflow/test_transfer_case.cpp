@@ -197,6 +197,8 @@ TEST(CliTransfer, BadInputNamesTheKey) {
       {{"fibre.E1=0.0"}, "fibre.E1"},
       {{"impregnation.vf_undeformed=0.95"}, "impregnation.vf_undeformed"},
       {{"trim.radius=1e-4"}, "trim.radius"},
+      {{"stitches.keep=true", "stitches.modulus=0.0"}, "stitches.modulus"},
+      {{"stitches.keep=true", "stitches.capture_distance=-1e-3"}, "stitches.capture_distance"},
   };
   for (const auto& b : bad) {
     std::vector<std::string> args{"run", f.transfer_case.string(), "-o", (f.dir / "bad").string()};
