@@ -53,6 +53,44 @@ void check_optional(const std::vector<T>& values, std::size_t n, const char* nam
   }
 }
 
+// The shell (quad4) arrays: connectivity and parts like the other kinds, the optional per-shell
+// arrays, and the values the hand-off gives a meaning to (thickness, material index).
+void check_shells(const ResultMesh& mesh) {
+  if (mesh.quad4.size() % 4 != 0) {
+    throw std::invalid_argument("ResultMesh: quad4 has " + std::to_string(mesh.quad4.size()) +
+                                " node ids, not a multiple of 4");
+  }
+  const std::size_t n = mesh.n_quad();
+  if (mesh.quad_part.size() != n) {
+    throw std::invalid_argument("ResultMesh: quad_part has " +
+                                std::to_string(mesh.quad_part.size()) + " entries for " +
+                                std::to_string(n) + " shells");
+  }
+  check_node_ids(mesh.quad4, 4, mesh.n_points(), "shell");
+  check_part_ids(mesh.quad_part, "shell");
+  check_optional(mesh.quad_user_id, n, "quad_user_id", "shells");
+  check_optional(mesh.quad_material, n, "quad_material", "shells");
+  check_optional(mesh.quad_thickness, n, "quad_thickness", "shells");
+  for (std::size_t i = 0; i < mesh.quad_thickness.size(); ++i) {
+    const double t = mesh.quad_thickness[i];
+    if (!std::isfinite(t) || t <= 0) {
+      throw std::invalid_argument("ResultMesh: " + entity_text("shell", i) + " has thickness " +
+                                  detail::format_double(t) + " m, not a finite value > 0");
+    }
+  }
+  const auto n_materials = static_cast<std::int64_t>(mesh.material_names.size());
+  for (std::size_t i = 0; i < mesh.quad_material.size(); ++i) {
+    const std::int32_t m = mesh.quad_material[i];
+    if (m < -1 || (n_materials > 0 && m >= n_materials)) {
+      throw std::invalid_argument(
+          "ResultMesh: " + entity_text("shell", i) + " has material index " + std::to_string(m) +
+          ", allowed -1 (none)" +
+          (n_materials > 0 ? " or [0, " + std::to_string(n_materials) + ") (material_names)"
+                           : std::string(" or >= 0")));
+    }
+  }
+}
+
 }  // namespace
 
 void validate_mesh(const ResultMesh& mesh) {
@@ -87,11 +125,12 @@ void validate_mesh(const ResultMesh& mesh) {
   check_optional(mesh.hex_tow, mesh.n_hex(), "hex_tow", "hexahedra");
   check_optional(mesh.bar_user_id, mesh.n_bar(), "bar_user_id", "bars");
   check_optional(mesh.bar_material, mesh.n_bar(), "bar_material", "bars");
+  check_shells(mesh);
 }
 
 void validate_frame(const ResultMesh& mesh, const Frame& frame) {
   const std::size_t n_points = mesh.n_points();
-  const std::size_t n_cells = mesh.n_hex() + mesh.n_bar();
+  const std::size_t n_cells = mesh.n_cells();
   if (frame.displacement.size() != 3 * n_points) {
     throw std::invalid_argument("Frame (cycle " + std::to_string(frame.cycle) +
                                 "): displacement has " + std::to_string(frame.displacement.size()) +
@@ -123,7 +162,11 @@ void validate_frame(const ResultMesh& mesh, const Frame& frame) {
       throw std::invalid_argument(where + "has " + std::to_string(f.values.size()) +
                                   " values, expected " + std::to_string(expected) + " (" +
                                   std::to_string(f.n_components) + " x " + std::to_string(n) +
-                                  (f.on_cells ? " cells)" : " nodes)"));
+                                  (f.on_cells ? " cells: " + std::to_string(mesh.n_hex()) +
+                                                    " hexahedra, " + std::to_string(mesh.n_bar()) +
+                                                    " bars, " + std::to_string(mesh.n_quad()) +
+                                                    " shells, in that order)"
+                                              : std::string(" nodes)")));
     }
   }
 }
@@ -231,7 +274,7 @@ bool is_valid_field_name(std::string_view name) {
 
 bool is_reserved_field_name(std::string_view name) {
   return name == "coordinates" || name == "displacement" || name == "part_id" || name == "hex8" ||
-         name == "bar2";
+         name == "bar2" || name == "quad4";
 }
 
 }  // namespace detail

@@ -2,6 +2,8 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
+#include <limits>
 #include <map>
 #include <stdexcept>
 
@@ -39,8 +41,9 @@ hid_t open_unlocked(const std::filesystem::path& file) {
 }
 
 // Reads a dataset of rank 1 or 2 as doubles (or int64 with `as_int`); returns dims.
-std::vector<hsize_t> read_dataset(const std::filesystem::path& file, hid_t loc, const std::string& name,
-                                  hid_t mem_type, void* (*resize)(void*, std::size_t), void* target) {
+std::vector<hsize_t> read_dataset(const std::filesystem::path& file, hid_t loc,
+                                  const std::string& name, hid_t mem_type,
+                                  void* (*resize)(void*, std::size_t), void* target) {
   if (H5Lexists(loc, name.c_str(), H5P_DEFAULT) <= 0) fail(file, "no dataset '" + name + "'");
   Handle d(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
   if (d.id < 0) fail(file, "cannot open dataset '" + name + "'");
@@ -65,12 +68,13 @@ void* resize_vec(void* v, std::size_t n) {
 
 std::vector<std::string> list_links(hid_t group) {
   std::vector<std::string> names;
-  H5Literate(group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
-              [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
-                static_cast<std::vector<std::string>*>(data)->push_back(name);
-                return 0;
-              },
-              &names);
+  H5Literate(
+      group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
+      [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
+        static_cast<std::vector<std::string>*>(data)->push_back(name);
+        return 0;
+      },
+      &names);
   return names;
 }
 
@@ -81,7 +85,8 @@ bool is_group(hid_t loc, const std::string& name) {
 }
 
 // A rank-1 variable-length string dataset (as write_string_dataset writes them).
-std::vector<std::string> read_strings(const std::filesystem::path& file, hid_t loc, const std::string& name) {
+std::vector<std::string> read_strings(const std::filesystem::path& file, hid_t loc,
+                                      const std::string& name) {
   Handle d(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
   if (d.id < 0) fail(file, "cannot open dataset '" + name + "'");
   Handle s(H5Dget_space(d.id), H5Sclose);
@@ -110,7 +115,8 @@ struct FrameGroup {
     if (f.id < 0) fail(file, "not a readable HDF5 file");
     if (g.id < 0) fail(file, "no group " + name);
   }
-  static std::string group_name(const std::filesystem::path& file, std::size_t n_frames, std::size_t index) {
+  static std::string group_name(const std::filesystem::path& file, std::size_t n_frames,
+                                std::size_t index) {
     if (index >= n_frames) fail(file, "frame " + std::to_string(index) + " not in the file");
     return "/frames/" + detail::zero_padded(index, 6);
   }
@@ -121,7 +127,23 @@ struct FrameGroup {
 template <class T>
 void read_optional(const std::filesystem::path& file, hid_t loc, const char* name, hid_t mem_type,
                    std::vector<T>& target) {
-  if (H5Lexists(loc, name, H5P_DEFAULT) > 0) read_dataset(file, loc, name, mem_type, resize_vec<T>, &target);
+  if (H5Lexists(loc, name, H5P_DEFAULT) > 0)
+    read_dataset(file, loc, name, mem_type, resize_vec<T>, &target);
+}
+
+// The shells (quad4) of /mesh, present only in a file whose mesh has them.
+void read_shells(const std::filesystem::path& file, hid_t g, ResultMesh& mesh) {
+  if (H5Lexists(g, "quad4", H5P_DEFAULT) <= 0) return;
+  const auto dims =
+      read_dataset(file, g, "quad4", H5T_NATIVE_INT64, resize_vec<std::int64_t>, &mesh.quad4);
+  if (dims.size() != 2 || dims[1] != 4)
+    fail(file, "dataset '/mesh/quad4' is not [n_quad, 4] (4 node ids per shell)");
+  if (H5Lexists(g, "quad_part", H5P_DEFAULT) <= 0)
+    fail(file, "dataset '/mesh/quad4' without '/mesh/quad_part'");
+  read_dataset(file, g, "quad_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>, &mesh.quad_part);
+  read_optional(file, g, "quad_user_id", H5T_NATIVE_INT64, mesh.quad_user_id);
+  read_optional(file, g, "quad_material", H5T_NATIVE_INT32, mesh.quad_material);
+  read_optional(file, g, "quad_thickness", H5T_NATIVE_DOUBLE, mesh.quad_thickness);
 }
 
 }  // namespace
@@ -145,10 +167,13 @@ ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
   if (H5Lexists(g.id, "bar2", H5P_DEFAULT) > 0)
     read_dataset(path_, g.id, "bar2", H5T_NATIVE_INT64, resize_vec<std::int64_t>, &mesh_.bar2);
   if (H5Lexists(g.id, "hex_part", H5P_DEFAULT) > 0)
-    read_dataset(path_, g.id, "hex_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>, &mesh_.hex_part);
+    read_dataset(path_, g.id, "hex_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>,
+                 &mesh_.hex_part);
   if (H5Lexists(g.id, "bar_part", H5P_DEFAULT) > 0)
-    read_dataset(path_, g.id, "bar_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>, &mesh_.bar_part);
-  if (H5Lexists(g.id, "part_names", H5P_DEFAULT) > 0) mesh_.part_names = read_strings(path_, g.id, "part_names");
+    read_dataset(path_, g.id, "bar_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>,
+                 &mesh_.bar_part);
+  if (H5Lexists(g.id, "part_names", H5P_DEFAULT) > 0)
+    mesh_.part_names = read_strings(path_, g.id, "part_names");
   // The stage hand-off datasets (format_version 2; absent in older files).
   read_optional(path_, g.id, "node_user_id", H5T_NATIVE_INT64, mesh_.node_user_id);
   read_optional(path_, g.id, "hex_user_id", H5T_NATIVE_INT64, mesh_.hex_user_id);
@@ -157,17 +182,26 @@ ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
   read_optional(path_, g.id, "bar_material", H5T_NATIVE_INT32, mesh_.bar_material);
   read_optional(path_, g.id, "hex_ply", H5T_NATIVE_INT32, mesh_.hex_ply);
   read_optional(path_, g.id, "hex_tow", H5T_NATIVE_INT32, mesh_.hex_tow);
+  read_shells(path_, g.id, mesh_);
   if (H5Lexists(g.id, "material_names", H5P_DEFAULT) > 0)
     mesh_.material_names = read_strings(path_, g.id, "material_names");
   if (H5Lexists(g.id, "bar_law_names", H5P_DEFAULT) > 0)
     mesh_.bar_law_names = read_strings(path_, g.id, "bar_law_names");
+  // What the writer checked before writing, checked again on what came back (a damaged or foreign
+  // file fails here, naming the file, rather than in a later stage's indexing).
+  try {
+    validate_mesh(mesh_);
+  } catch (const std::invalid_argument& e) {
+    fail(path_, std::string("inconsistent /mesh: ") + e.what());
+  }
 }
 
 double ResultReader::frame_time(std::size_t index) const {
   const FrameGroup fg(path_, n_frames_, index);
   double t = 0;
   Handle a(H5Aopen(fg.g.id, "time", H5P_DEFAULT), H5Aclose);
-  if (a.id < 0 || H5Aread(a.id, H5T_NATIVE_DOUBLE, &t) < 0) fail(path_, "no attribute time on " + fg.name);
+  if (a.id < 0 || H5Aread(a.id, H5T_NATIVE_DOUBLE, &t) < 0)
+    fail(path_, "no attribute time on " + fg.name);
   return t;
 }
 
@@ -182,37 +216,43 @@ StoredFrame ResultReader::frame(std::size_t index) const {
     if (c.id >= 0) H5Aread(c.id, H5T_NATIVE_INT, &fr.cycle);
   }
   read_dataset(path_, gid, "coordinates", H5T_NATIVE_DOUBLE, resize_vec<double>, &fr.coordinates);
-  const std::size_t np = mesh_.n_points(), nh = mesh_.n_hex(), nb = mesh_.n_bar();
+  const std::size_t nh = mesh_.n_hex(), nb = mesh_.n_bar(), n_cells = mesh_.n_cells();
   for (const auto& name : list_links(gid)) {
     if (name == "coordinates" || is_group(gid, name)) continue;
     FrameField ff;
     ff.name = name;
-    const auto dims = read_dataset(path_, gid, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &ff.values);
+    const auto dims =
+        read_dataset(path_, gid, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &ff.values);
     ff.n_components = dims.size() > 1 ? static_cast<int>(dims[1]) : 1;
     fr.fields.push_back(std::move(ff));
   }
-  // Cell fields: join the hex and bar slices (missing slice -> NaN).
+  // Cell fields: join the hex, bar and shell slices in that order (missing slice -> NaN).
   std::map<std::string, FrameField> cells;
-  for (const char* kind : {"hex8", "bar2"}) {
-    if (H5Lexists(gid, kind, H5P_DEFAULT) <= 0) continue;
-    Handle cg(H5Gopen2(gid, kind, H5P_DEFAULT), H5Gclose);
-    const bool hex = std::string(kind) == "hex8";
+  struct Slice {
+    const char* kind;
+    std::size_t first_cell;
+  };
+  for (const Slice slice : {Slice{"hex8", 0}, Slice{"bar2", nh}, Slice{"quad4", nh + nb}}) {
+    if (H5Lexists(gid, slice.kind, H5P_DEFAULT) <= 0) continue;
+    Handle cg(H5Gopen2(gid, slice.kind, H5P_DEFAULT), H5Gclose);
     for (const auto& name : list_links(cg.id)) {
       std::vector<double> vals;
-      const auto dims = read_dataset(path_, cg.id, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &vals);
+      const auto dims =
+          read_dataset(path_, cg.id, name, H5T_NATIVE_DOUBLE, resize_vec<double>, &vals);
       const int nc = dims.size() > 1 ? static_cast<int>(dims[1]) : 1;
       auto& ff = cells[name];
       if (ff.values.empty()) {
         ff.name = name, ff.on_cells = true, ff.n_components = nc;
-        ff.values.assign(static_cast<std::size_t>(nc) * (nh + nb), std::numeric_limits<double>::quiet_NaN());
+        ff.values.assign(static_cast<std::size_t>(nc) * n_cells,
+                         std::numeric_limits<double>::quiet_NaN());
       }
       if (nc != ff.n_components) continue;
-      const std::size_t offset = hex ? 0 : static_cast<std::size_t>(nc) * nh;
-      for (std::size_t i = 0; i < vals.size() && offset + i < ff.values.size(); ++i) ff.values[offset + i] = vals[i];
+      const std::size_t offset = static_cast<std::size_t>(nc) * slice.first_cell;
+      for (std::size_t i = 0; i < vals.size() && offset + i < ff.values.size(); ++i)
+        ff.values[offset + i] = vals[i];
     }
   }
   for (auto& [name, ff] : cells) fr.fields.push_back(std::move(ff));
-  (void)np;
   return fr;
 }
 

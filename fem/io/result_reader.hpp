@@ -13,7 +13,9 @@ struct StoredFrame {
   double time = 0;
   int cycle = 0;
   std::vector<double> coordinates;  // [3*n_points] current positions
-  std::vector<FrameField> fields;   // nodal fields, then cell fields (hex and bar slices joined)
+  /// Nodal fields, then cell fields: the hex, bar and shell slices joined in that order
+  /// ([n_components * n_cells()]), NaN where a kind's slice is missing.
+  std::vector<FrameField> fields;
 };
 
 class ResultReader {

@@ -10,13 +10,22 @@
 //   /mesh/hex_part      int32   [n_hex]        part id per hexahedron
 //   /mesh/bar_part      int32   [n_bar]
 //   /mesh/part_names    string  [n_parts]      variable-length UTF-8, indexed by part id
+//   Shells (only in a file whose mesh has them; a file without shells has none of these, so
+//   hex/bar files are what they were before shells, and a reader treats a missing /mesh/quad4 as
+//   no shells):
+//   /mesh/quad4         int64   [n_quad, 4]    node ids, counter-clockwise (VTK_QUAD order; the
+//                                              normal by the right-hand rule)
+//   /mesh/quad_part     int32   [n_quad]
 //   Stage hand-off (format_version 2; each written only when the mesh carries it, a reader
 //   treats a missing one as unknown):
 //   /mesh/node_user_id  int64   [n_points]     node number given by the user (messages, export)
 //   /mesh/hex_user_id   int64   [n_hex]        element number given by the user
 //   /mesh/bar_user_id   int64   [n_bar]
+//   /mesh/quad_user_id  int64   [n_quad]
 //   /mesh/hex_material  int32   [n_hex]        index into /mesh/material_names (-1: none)
 //   /mesh/bar_material  int32   [n_bar]        index into /mesh/bar_law_names (-1: none)
+//   /mesh/quad_material int32   [n_quad]       index into /mesh/material_names (-1: none)
+//   /mesh/quad_thickness float64 [n_quad]      shell thickness, m
 //   /mesh/material_names string [n_materials]  the case's [[material]] names, in case order
 //   /mesh/bar_law_names string  [n_bar_laws]   the case's [[bar_law]] names, in case order
 //   /mesh/hex_ply       int32   [n_hex]        fabric ply index within its blanket (-1: not a tow)
@@ -28,14 +37,16 @@
 //   /frames/NNNNNN/<nodal field>       float64 [n_points] or [n_points, n_components]
 //   /frames/NNNNNN/hex8/<cell field>   float64 [n_hex]    or [n_hex, n_components]
 //   /frames/NNNNNN/bar2/<cell field>   float64 [n_bar]    or [n_bar, n_components]
-//   /                   attributes format = "ncfsim-results", format_version (int32),
-//                       n_frames (int32, frames complete in the file)
+//   /frames/NNNNNN/quad4/<cell field>  float64 [n_quad]   or [n_quad, n_components] (with shells)
+//   /                   attributes format = "ncfsim-results", format_version (int32, 2: shells
+//                       did not change it, see docs/output.md), n_frames (int32, frames complete
+//                       in the file)
 //
 // results.xdmf: Domain / Grid "results" (Collection, Temporal) / one Grid per frame (Collection,
-// Spatial, with <Time Value>) holding Uniform grids "solids" (Hexahedron) and "bars" (Polyline,
-// NodesPerElement 2); an empty block is left out. Both share the frame's coordinates (the deformed
-// geometry) and carry every nodal field; cell fields and "part_id" are split into the hex and bar
-// slices.
+// Spatial, with <Time Value>) holding Uniform grids "solids" (Hexahedron), "bars" (Polyline,
+// NodesPerElement 2) and "shells" (Quadrilateral), in that order; an empty block is left out. All
+// share the frame's coordinates (the deformed geometry) and carry every nodal field; cell fields
+// and "part_id" are split into the hex, bar and shell slices.
 //
 // Crash consistency: results.h5 is opened, written, flushed and closed inside each write_frame, so
 // between calls it is a closed, complete file that other processes may open read-only. The frame
@@ -45,10 +56,11 @@
 // (results.h5 itself may be damaged in that case: HDF5 1.10 has no journal).
 //
 // VtuSeriesWriter: <out_dir>/frames/frame_NNNNN.vtu (vtkXMLUnstructuredGridWriter, appended raw
-// binary, zlib, UInt64 headers; points = current coordinates; VTK_HEXAHEDRON cells then VTK_LINE
-// cells; point data "displacement" + nodal fields; cell data "part_id" + cell fields) and
-// <out_dir>/results.pvd, a ParaView collection with one DataSet (timestep = time) per frame. Each
-// .vtu is written under a temporary name and renamed; results.pvd is replaced atomically after.
+// binary, zlib, UInt64 headers; points = current coordinates; VTK_HEXAHEDRON cells, then VTK_LINE
+// cells, then VTK_QUAD cells; point data "displacement" + nodal fields; cell data "part_id" + cell
+// fields) and <out_dir>/results.pvd, a ParaView collection with one DataSet (timestep = time) per
+// frame. Each .vtu is written under a temporary name and renamed; results.pvd is replaced
+// atomically after.
 //
 // Errors: bad input -> std::invalid_argument; HDF5/VTK/file-system failure -> std::runtime_error
 // naming the file (and HDF5 object); write_frame after close() -> std::logic_error.
@@ -75,18 +87,28 @@ struct ResultMesh {
   std::vector<std::int32_t> bar_material;  ///< index into bar_law_names (-1: none)
   std::vector<std::string> material_names;
   std::vector<std::string> bar_law_names;
-  std::vector<std::int32_t> hex_ply;       ///< fabric ply per hexahedron (-1: not a tow)
-  std::vector<std::int32_t> hex_tow;       ///< fabric tow per hexahedron (-1: not a tow)
+  std::vector<std::int32_t> hex_ply;  ///< fabric ply per hexahedron (-1: not a tow)
+  std::vector<std::int32_t> hex_tow;  ///< fabric tow per hexahedron (-1: not a tow)
+  // Shells (quad4), after the hexahedra and bars in every per-cell order.
+  std::vector<std::int64_t> quad4;          ///< 4 node ids per shell, counter-clockwise (VTK_QUAD)
+  std::vector<std::int32_t> quad_part;      ///< part id per shell
+  std::vector<std::int64_t> quad_user_id;   ///< per shell (optional, like hex_user_id)
+  std::vector<std::int32_t> quad_material;  ///< index into material_names (-1: none; optional)
+  std::vector<double> quad_thickness;       ///< m, > 0 (optional: empty = unknown)
 
   std::size_t n_points() const { return points.size() / 3; }
   std::size_t n_hex() const { return hex8.size() / 8; }
   std::size_t n_bar() const { return bar2.size() / 2; }
+  std::size_t n_quad() const { return quad4.size() / 4; }
+  /// Cells of every kind: the length of a one-component cell field.
+  std::size_t n_cells() const { return n_hex() + n_bar() + n_quad(); }
 };
 
 /// A nodal field has values [n_components * n_points]; a cell field [n_components * (n_hex +
-/// n_bar)], hexes first then bars. Components are interleaved per entity. Names use only letters,
-/// digits and _ - . + ( ) [ ] (no spaces), are unique within a frame, and are not "coordinates",
-/// "displacement", "part_id", "hex8", "bar2". The set of fields may differ from frame to frame.
+/// n_bar + n_quad)], hexes first, then bars, then shells (the element kind order). Components are
+/// interleaved per entity. Names use only letters, digits and _ - . + ( ) [ ] (no spaces), are
+/// unique within a frame, and are not "coordinates", "displacement", "part_id", "hex8", "bar2",
+/// "quad4". The set of fields may differ from frame to frame.
 struct FrameField {
   std::string name;
   bool on_cells = false;
@@ -102,8 +124,9 @@ struct Frame {
 };
 
 /// Throws std::invalid_argument if the mesh is inconsistent (sizes, node ids out of range,
-/// negative part ids, an optional per-element array neither empty nor sized like its elements).
-/// Part ids need not have a name.
+/// negative part ids, an optional per-element array neither empty nor sized like its elements, a
+/// shell thickness not finite and > 0, a shell material below -1 or past material_names when
+/// those are given). Part ids need not have a name.
 void validate_mesh(const ResultMesh& mesh);
 /// Throws std::invalid_argument if the frame does not fit the mesh.
 void validate_frame(const ResultMesh& mesh, const Frame& frame);

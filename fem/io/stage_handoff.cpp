@@ -15,7 +15,8 @@ const FrameField* StageFrame::field(const std::string& name) const {
 
 namespace {
 
-StageFrame make_stage_frame(const std::filesystem::path& h5, const ResultReader& reader, std::size_t index) {
+StageFrame make_stage_frame(const std::filesystem::path& h5, const ResultReader& reader,
+                            std::size_t index) {
   StoredFrame sf = reader.frame(index);
   StageFrame out;
   out.file = h5;
@@ -38,8 +39,8 @@ StageFrame make_stage_frame(const std::filesystem::path& h5, const ResultReader&
 StageFrame read_frame(const std::filesystem::path& h5, std::size_t index) {
   const ResultReader reader(h5);
   if (index >= reader.n_frames())
-    throw std::out_of_range(h5.string() + ": no frame " + std::to_string(index) + " (the file holds " +
-                            std::to_string(reader.n_frames()) + ")");
+    throw std::out_of_range(h5.string() + ": no frame " + std::to_string(index) +
+                            " (the file holds " + std::to_string(reader.n_frames()) + ")");
   return make_stage_frame(h5, reader, index);
 }
 
@@ -52,7 +53,8 @@ StageFrame read_frame_at_time(const std::filesystem::path& h5, double time) {
     found = k;
   }
   if (found == reader.n_frames())
-    throw std::out_of_range(h5.string() + ": no frame at or before t = " + std::to_string(time) + " s");
+    throw std::out_of_range(h5.string() + ": no frame at or before t = " + std::to_string(time) +
+                            " s");
   return make_stage_frame(h5, reader, found);
 }
 

@@ -18,18 +18,20 @@
 namespace ncfsim::fem::io {
 
 struct StageFrame {
-  std::filesystem::path file;      ///< the results.h5 it came from
-  std::size_t index = 0;           ///< frame index in the file (0-based)
-  std::size_t n_frames = 0;        ///< frames in the file
-  double time = 0;                 ///< s
+  std::filesystem::path file;  ///< the results.h5 it came from
+  std::size_t index = 0;       ///< frame index in the file (0-based)
+  std::size_t n_frames = 0;    ///< frames in the file
+  double time = 0;             ///< s
   int cycle = 0;
-  /// Connectivity per kind (hex8, bar2), per-element part / material / user / ply / tow ids, part
-  /// and material names, reference coordinates (mesh.points). Optional ids the file does not
-  /// hold (written before format_version 2) are empty.
+  /// Connectivity per kind (hex8, bar2, quad4), per-element part / material / user / ply / tow
+  /// ids, shell thicknesses, part and material names, reference coordinates (mesh.points).
+  /// Optional ids the file does not hold (written before format_version 2) are empty; a file
+  /// without shells gives an empty quad4.
   ResultMesh mesh;
   std::vector<double> coordinates;  ///< current positions of the frame [3*n_points]
   /// The frame's nodal fields (displacement, velocity, ...: [n_components * n_points]) and cell
-  /// fields ([n_components * (n_hex + n_bar)], hexahedra first, NaN where a kind lacks it).
+  /// fields ([n_components * (n_hex + n_bar + n_quad)]: hexahedra, bars, then shells; NaN where a
+  /// kind lacks it).
   std::vector<FrameField> fields;
 
   std::size_t n_points() const { return mesh.n_points(); }

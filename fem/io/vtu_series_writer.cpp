@@ -69,12 +69,14 @@ struct VtuSeriesWriter::Impl {
 void VtuSeriesWriter::Impl::build_topology() {
   const std::size_t n_hex = mesh.n_hex();
   const std::size_t n_bar = mesh.n_bar();
-  const std::size_t n_cells = n_hex + n_bar;
+  const std::size_t n_quad = mesh.n_quad();
+  const std::size_t n_cells = mesh.n_cells();
 
   vtkNew<vtkIdTypeArray> offsets;
   offsets->SetNumberOfValues(static_cast<vtkIdType>(n_cells + 1));
   vtkNew<vtkIdTypeArray> connectivity;
-  connectivity->SetNumberOfValues(static_cast<vtkIdType>(mesh.hex8.size() + mesh.bar2.size()));
+  connectivity->SetNumberOfValues(
+      static_cast<vtkIdType>(mesh.hex8.size() + mesh.bar2.size() + mesh.quad4.size()));
   cell_types = vtkSmartPointer<vtkUnsignedCharArray>::New();
   cell_types->SetNumberOfValues(static_cast<vtkIdType>(n_cells));
   part_id = vtkSmartPointer<vtkIntArray>::New();
@@ -94,6 +96,12 @@ void VtuSeriesWriter::Impl::build_topology() {
     offsets->SetValue(c + 1, k);
     cell_types->SetValue(c, VTK_LINE);
     part_id->SetValue(c, mesh.bar_part[e]);
+  }
+  for (std::size_t e = 0; e < n_quad; ++e, ++c) {
+    for (int j = 0; j < 4; ++j) connectivity->SetValue(k++, mesh.quad4[4 * e + j]);
+    offsets->SetValue(c + 1, k);
+    cell_types->SetValue(c, VTK_QUAD);
+    part_id->SetValue(c, mesh.quad_part[e]);
   }
   cells = vtkSmartPointer<vtkCellArray>::New();
   cells->SetData(offsets, connectivity);
@@ -145,7 +153,7 @@ void VtuSeriesWriter::write_frame(const Frame& frame) {
   const ResultMesh& mesh = impl_->mesh;
   validate_frame(mesh, frame);
   const std::size_t n_points = mesh.n_points();
-  const std::size_t n_cells = mesh.n_hex() + mesh.n_bar();
+  const std::size_t n_cells = mesh.n_cells();  // hexes, bars, shells: the order of the cell fields
 
   const std::vector<double> x = detail::current_coordinates(mesh, frame);
   vtkNew<vtkPoints> points;

@@ -2,22 +2,23 @@
 // Layout and consistency rules: see result_writers.hpp.
 #include <hdf5.h>
 
+#include <chrono>
 #include <cstdint>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include "fem/io/io_detail.hpp"
 #include "fem/io/result_writers.hpp"
 
-#include <chrono>
-#include <thread>
-
 namespace ncfsim::fem::io {
 
 namespace {
 
-constexpr int kFormatVersion = 2;  // 2: the stage hand-off datasets (user ids, materials, ply/tow)
+// 2: the stage hand-off datasets (user ids, materials, ply/tow). Shells (quad4) did not change it:
+// their datasets are only added, only to a file that has shells (docs/output.md).
+constexpr int kFormatVersion = 2;
 constexpr int kFrameDigits = 6;
 constexpr const char* kH5Name = "results.h5";
 constexpr const char* kXdmfName = "results.xdmf";
@@ -223,6 +224,16 @@ const char* attribute_type(int n_components) {
   }
 }
 
+/// One Uniform grid of a frame: a kind's cells, where its connectivity, parts and cell fields are.
+struct GridBlock {
+  const char* name;      // "solids", "bars", "shells"
+  const char* topology;  // the Topology element's attributes
+  int nodes_per_cell;
+  std::size_t n_cells;
+  const char* kind;  // "hex8", "bar2", "quad4": /mesh/<kind> and /frames/NNNNNN/<kind>/
+  const char* part;  // /mesh/<part>
+};
+
 }  // namespace
 
 // --- Writer
@@ -251,7 +262,8 @@ struct XdmfResultWriter::Impl {
   void write_handoff_datasets(hid_t mesh_group) const;
   void write_frame_h5(const Frame& frame, const std::string& group) const;
   std::string xdmf_text() const;
-  void append_uniform_grid(std::ostringstream& x, const FrameRecord& fr, bool solids) const;
+  void append_uniform_grid(std::ostringstream& x, const FrameRecord& fr,
+                           const GridBlock& block) const;
 };
 
 void XdmfResultWriter::Impl::create_h5() const {
@@ -283,6 +295,13 @@ void XdmfResultWriter::Impl::create_h5() const {
     write_dataset(g.get(), "bar_part", H5T_STD_I32LE, H5T_NATIVE_INT32, {nb}, mesh.bar_part.data(),
                   at("/mesh/bar_part"));
     write_string_dataset(g.get(), "part_names", mesh.part_names, at("/mesh/part_names"));
+    if (const auto nq = static_cast<hsize_t>(mesh.n_quad()); nq > 0) {
+      // Only with shells: a file without them keeps the layout it had before shells.
+      write_dataset(g.get(), "quad4", H5T_STD_I64LE, H5T_NATIVE_INT64, {nq, 4}, mesh.quad4.data(),
+                    at("/mesh/quad4"));
+      write_dataset(g.get(), "quad_part", H5T_STD_I32LE, H5T_NATIVE_INT32, {nq},
+                    mesh.quad_part.data(), at("/mesh/quad_part"));
+    }
     write_handoff_datasets(g.get());
   }
   create_group(file.get(), "frames", at("/frames"));
@@ -294,13 +313,13 @@ void XdmfResultWriter::Impl::create_h5() const {
 void XdmfResultWriter::Impl::write_handoff_datasets(hid_t g) const {
   auto ids64 = [&](const char* name, const std::vector<std::int64_t>& v) {
     if (v.empty()) return;
-    write_dataset(g, name, H5T_STD_I64LE, H5T_NATIVE_INT64, {static_cast<hsize_t>(v.size())}, v.data(),
-                  at(std::string("/mesh/") + name));
+    write_dataset(g, name, H5T_STD_I64LE, H5T_NATIVE_INT64, {static_cast<hsize_t>(v.size())},
+                  v.data(), at(std::string("/mesh/") + name));
   };
   auto ids32 = [&](const char* name, const std::vector<std::int32_t>& v) {
     if (v.empty()) return;
-    write_dataset(g, name, H5T_STD_I32LE, H5T_NATIVE_INT32, {static_cast<hsize_t>(v.size())}, v.data(),
-                  at(std::string("/mesh/") + name));
+    write_dataset(g, name, H5T_STD_I32LE, H5T_NATIVE_INT32, {static_cast<hsize_t>(v.size())},
+                  v.data(), at(std::string("/mesh/") + name));
   };
   ids64("node_user_id", mesh.node_user_id);
   ids64("hex_user_id", mesh.hex_user_id);
@@ -309,6 +328,13 @@ void XdmfResultWriter::Impl::write_handoff_datasets(hid_t g) const {
   ids32("bar_material", mesh.bar_material);
   ids32("hex_ply", mesh.hex_ply);
   ids32("hex_tow", mesh.hex_tow);
+  ids64("quad_user_id", mesh.quad_user_id);
+  ids32("quad_material", mesh.quad_material);
+  if (!mesh.quad_thickness.empty()) {
+    write_dataset(g, "quad_thickness", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                  {static_cast<hsize_t>(mesh.quad_thickness.size())}, mesh.quad_thickness.data(),
+                  at("/mesh/quad_thickness"));
+  }
   if (!mesh.material_names.empty())
     write_string_dataset(g, "material_names", mesh.material_names, at("/mesh/material_names"));
   if (!mesh.bar_law_names.empty())
@@ -346,7 +372,7 @@ void XdmfResultWriter::Impl::write_frame_h5(const Frame& frame, const std::strin
     write_dataset(g.get(), "displacement", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {nd, 3},
                   frame.displacement.data(), at(group + "/displacement"));
 
-    H5Id hex_group, bar_group;
+    H5Id hex_group, bar_group, quad_group;
     for (const FrameField& f : frame.fields) {
       if (!f.on_cells) {
         write_dataset(g.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
@@ -357,14 +383,22 @@ void XdmfResultWriter::Impl::write_frame_h5(const Frame& frame, const std::strin
       if (hex_group.get() < 0) {
         hex_group = create_group(g.get(), "hex8", at(group + "/hex8"));
         bar_group = create_group(g.get(), "bar2", at(group + "/bar2"));
+        if (mesh.n_quad() > 0) quad_group = create_group(g.get(), "quad4", at(group + "/quad4"));
       }
-      const std::size_t n_hex_values = mesh.n_hex() * static_cast<std::size_t>(f.n_components);
+      const auto nc = static_cast<std::size_t>(f.n_components);
+      const std::size_t n_hex_values = mesh.n_hex() * nc;
       write_dataset(hex_group.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
                     field_dims(mesh.n_hex(), f.n_components), f.values.data(),
                     at(group + "/hex8/" + f.name));
       write_dataset(bar_group.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
                     field_dims(mesh.n_bar(), f.n_components), f.values.data() + n_hex_values,
                     at(group + "/bar2/" + f.name));
+      if (mesh.n_quad() > 0) {
+        write_dataset(quad_group.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                      field_dims(mesh.n_quad(), f.n_components),
+                      f.values.data() + n_hex_values + mesh.n_bar() * nc,
+                      at(group + "/quad4/" + f.name));
+      }
     }
   }
   const auto n_frames = static_cast<std::int32_t>(frames.size() + 1);
@@ -374,9 +408,10 @@ void XdmfResultWriter::Impl::write_frame_h5(const Frame& frame, const std::strin
 }
 
 void XdmfResultWriter::Impl::append_uniform_grid(std::ostringstream& x, const FrameRecord& fr,
-                                                 bool solids) const {
+                                                 const GridBlock& block) const {
   const std::size_t n_points = mesh.n_points();
-  const std::size_t n_cells = solids ? mesh.n_hex() : mesh.n_bar();
+  const std::size_t n_cells = block.n_cells;
+  const std::string kind = block.kind;
   const std::string h5name = kH5Name;
   auto data_item = [&](const std::string& dims, const char* number_type, int precision,
                        const std::string& path) {
@@ -389,23 +424,17 @@ void XdmfResultWriter::Impl::append_uniform_grid(std::ostringstream& x, const Fr
       << attribute_type(n_components) << "\" Center=\"" << (on_cells ? "Cell" : "Node") << "\">\n";
   };
 
-  x << "        <Grid Name=\"" << (solids ? "solids" : "bars") << "\" GridType=\"Uniform\">\n";
-  if (solids) {
-    x << "          <Topology TopologyType=\"Hexahedron\" NumberOfElements=\"" << n_cells
-      << "\">\n";
-    data_item(std::to_string(n_cells) + " 8", "Int", 8, "/mesh/hex8");
-  } else {
-    x << "          <Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\""
-      << n_cells << "\">\n";
-    data_item(std::to_string(n_cells) + " 2", "Int", 8, "/mesh/bar2");
-  }
+  x << "        <Grid Name=\"" << block.name << "\" GridType=\"Uniform\">\n";
+  x << "          <Topology " << block.topology << " NumberOfElements=\"" << n_cells << "\">\n";
+  data_item(std::to_string(n_cells) + " " + std::to_string(block.nodes_per_cell), "Int", 8,
+            "/mesh/" + kind);
   x << "          </Topology>\n";
   x << "          <Geometry GeometryType=\"XYZ\">\n";
   data_item(std::to_string(n_points) + " 3", "Float", 8, fr.group + "/coordinates");
   x << "          </Geometry>\n";
 
   attribute("part_id", 1, true);
-  data_item(std::to_string(n_cells), "Int", 4, solids ? "/mesh/hex_part" : "/mesh/bar_part");
+  data_item(std::to_string(n_cells), "Int", 4, std::string("/mesh/") + block.part);
   x << "          </Attribute>\n";
   attribute("displacement", 3, false);
   data_item(std::to_string(n_points) + " 3", "Float", 8, fr.group + "/displacement");
@@ -414,7 +443,7 @@ void XdmfResultWriter::Impl::append_uniform_grid(std::ostringstream& x, const Fr
     attribute(f.name, f.n_components, f.on_cells);
     if (f.on_cells) {
       data_item(dims_text(n_cells, f.n_components), "Float", 8,
-                fr.group + (solids ? "/hex8/" : "/bar2/") + f.name);
+                fr.group + "/" + kind + "/" + f.name);
     } else {
       data_item(dims_text(n_points, f.n_components), "Float", 8, fr.group + "/" + f.name);
     }
@@ -434,8 +463,14 @@ std::string XdmfResultWriter::Impl::xdmf_text() const {
       << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
       << "        <Time Value=\"" << detail::format_double(fr.time) << "\"/>\n"
       << "        <Information Name=\"cycle\" Value=\"" << fr.cycle << "\"/>\n";
-    if (mesh.n_hex() > 0) append_uniform_grid(x, fr, true);
-    if (mesh.n_bar() > 0) append_uniform_grid(x, fr, false);
+    const GridBlock blocks[] = {
+        {"solids", "TopologyType=\"Hexahedron\"", 8, mesh.n_hex(), "hex8", "hex_part"},
+        {"bars", "TopologyType=\"Polyline\" NodesPerElement=\"2\"", 2, mesh.n_bar(), "bar2",
+         "bar_part"},
+        {"shells", "TopologyType=\"Quadrilateral\"", 4, mesh.n_quad(), "quad4", "quad_part"}};
+    for (const GridBlock& block : blocks) {
+      if (block.n_cells > 0) append_uniform_grid(x, fr, block);
+    }
     x << "      </Grid>\n";
   }
   x << "    </Grid>\n"
