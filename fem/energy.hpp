@@ -21,7 +21,8 @@ inline constexpr double kEnergyScaleFloor = 1e-12;
 
 struct EnergyBalance {
   double time = 0;
-  double kinetic = 0;
+  double kinetic = 0;             // incl. rotational_kinetic
+  double rotational_kinetic = 0;  // of shell nodes' rotations (held by the shell groups)
   double internal = 0;         // stress work of all elements, incl. physical stabilisation
   double stabilisation = 0;    // part of internal carried by the hex stabilisation
   double hourglass = 0;        // viscous (non-physical) hourglass work

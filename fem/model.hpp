@@ -11,6 +11,7 @@
 #include "fem/contact_interface.hpp"
 #include "fem/boundary/picture_frame.hpp"
 #include "fem/material.hpp"
+#include "fem/membrane_law.hpp"
 #include "fem/mesh.hpp"
 #include "fem/rigid_tool.hpp"
 #include "fem/vec3.hpp"
@@ -27,12 +28,18 @@ struct PartProperties {
   std::array<double, 9> material_axes = kIdentityAxes;  // row-major, axes as columns, global
   double hourglass_stiffness = 1.0;
   double hourglass_viscosity = 0.05;
+  // Shells (Quad4): the section. A membrane law (a dry fabric) or the part's `material` (elastic
+  // isotropic, plane stress, integrated at Gauss points through the thickness).
+  double shell_thickness = 0;        // m
+  int shell_integration_points = 2;  // through the thickness
+  int membrane_law = -1;             // index into Model::membrane_laws
 };
 
 struct FixedDofs {
   std::string name;
   std::vector<std::int32_t> nodes;
   std::array<bool, 3> dofs{true, true, true};
+  std::array<bool, 3> rotations{false, false, false};  // shell nodes' rotations about x, y, z
 };
 
 struct PrescribedVelocity {
@@ -77,6 +84,7 @@ struct Model {
   Mesh mesh;
   std::vector<std::unique_ptr<SolidMaterial>> materials;
   std::vector<BarForceLaw> bar_laws;
+  std::vector<std::unique_ptr<MembraneLaw>> membrane_laws;  // shells' membrane laws
   std::vector<PartProperties> parts;  // indexed like mesh.part_names
   std::vector<FixedDofs> fixed;
   std::vector<PrescribedVelocity> velocities;

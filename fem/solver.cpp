@@ -481,6 +481,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     energy_.internal += inc.internal;
     energy_.stabilisation += inc.stabilisation;
     energy_.hourglass += inc.hourglass;
+    energy_.rotational_kinetic += inc.kinetic;
     step_ = st;
     dt_new = model_.time.safety_factor * st.dt;
     if (dt_prev_ > 0) dt_new = std::min(dt_new, 1.1 * dt_prev_);  // limit step growth
@@ -649,7 +650,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     tool_work_on_nodes_.add(tool_on_nodes_old, tool_on_nodes_new);
 
     energy_.time = t_;
-    energy_.kinetic = ke;
+    energy_.kinetic = ke + energy_.rotational_kinetic;
     energy_.external_work = w_ext_.committed + w_tools_.committed;
     energy_.damping = -w_damp_.committed;
     energy_.contact = tool_work_on_nodes_.committed - w_contact_nodes_.committed;

@@ -64,7 +64,12 @@ void read_boundary(CaseReadContext& ctx) {
   const auto bc = ctx.root.table("boundary");
   if (!bc) return;
   for (const auto& t : bc->tables("fixed"))
-    ctx.model.fixed.push_back(read_constraint_set<FixedDofs>(ctx, t));
+  {
+    auto set = read_constraint_set<FixedDofs>(ctx, t);
+    // Shell nodes' rotations (held by the shell groups); none unless named.
+    set.rotations = read_dofs(t, "rotations", {false, false, false});
+    ctx.model.fixed.push_back(std::move(set));
+  }
   for (const auto& t : bc->tables("velocity")) read_velocity(ctx, t);
   for (const auto& t : bc->tables("picture_frame")) read_picture_frame(ctx, t);
 }

@@ -20,6 +20,9 @@ namespace ncfsim::fem {
 /// May throw std::invalid_argument (a law's own consistency check): reported at `type`.
 using MaterialReader =
     std::function<std::unique_ptr<SolidMaterial>(const TableReader& t, const std::string& name, double density)>;
+/// Reads the type-specific keys of one [[membrane_law]] table (`name` is read already).
+using MembraneLawReader =
+    std::function<std::unique_ptr<MembraneLaw>(const TableReader& t, const std::string& name)>;
 
 /// Material type -> reader. Each module registers its own types by an explicit call
 /// (fem::register_fem_case_types, drape::register_drape_case_types), made by the case
@@ -31,16 +34,21 @@ class CaseTypeRegistry {
   std::vector<std::string> material_types() const;
   /// Reads `type` (one of the registered types), `density` (> 0) and dispatches to the type's reader.
   std::unique_ptr<SolidMaterial> read_material(const TableReader& t, const std::string& name) const;
+  /// Membrane laws of shells ([[membrane_law]] type = ...), registered by the module that has
+  /// them (drape: "fabric").
+  void add_membrane_law_type(std::string type, MembraneLawReader reader);
+  std::unique_ptr<MembraneLaw> read_membrane_law(const TableReader& t, const std::string& name) const;
 
  private:
   std::vector<std::pair<std::string, MaterialReader>> materials_;
+  std::vector<std::pair<std::string, MembraneLawReader>> membrane_laws_;
 };
 
 /// fem's own material types: elastic_isotropic, elastic_orthotropic.
 void register_fem_case_types(CaseTypeRegistry& registry);
 
 /// How a part of the mesh gets its properties.
-enum class PartKind { Solid, Bar };
+enum class PartKind { Solid, Bar, Shell };
 
 /// A selector key of node selections that names a node set a module made
 /// (`tow_end_pins = "fabric name"`).
@@ -66,6 +74,7 @@ struct CaseReadContext {
   std::map<std::string, PartKind> part_kind;         // part name -> what its elements are
   std::map<std::string, std::string> generated_parts;  // part name -> section that gives its properties
   std::map<std::string, int> materials, bar_laws;    // name -> index into model.materials / bar_laws
+  std::map<std::string, int> membrane_laws;          // name -> index into model.membrane_laws
   std::vector<char> part_defined;                    // per part: properties given
 
   std::map<std::string, NamedNodeSets> node_sets;  // selector key -> named sets

@@ -11,7 +11,7 @@
 
 namespace ncfsim::fem {
 
-/// [mesh].resolution, [[mesh.block]], [[mesh.line]] (`m` is the [mesh] table).
+/// [mesh].resolution, [[mesh.block]], [[mesh.line]], [[mesh.plate]] (`m` is the [mesh] table).
 void read_mesh_blocks(CaseReadContext& ctx, const TableReader& m);
 /// After every module made its elements: renumbers for locality (returns new-from-old node map)
 /// and sets the default user ids. Modules remap their node lists with the map.
@@ -19,6 +19,8 @@ std::vector<std::int32_t> finish_mesh(CaseReadContext& ctx);
 /// [[material]] (through the registry), [[bar_law]].
 void read_materials(CaseReadContext& ctx);
 void read_bar_laws(CaseReadContext& ctx);
+/// [[membrane_law]] (through the registry).
+void read_membrane_laws(CaseReadContext& ctx);
 /// [[part]]; then, after the modules gave their generated parts, check_parts_defined.
 void read_parts(CaseReadContext& ctx);
 void check_parts_defined(const CaseReadContext& ctx);

@@ -71,7 +71,27 @@ void read_part(CaseReadContext& ctx, const TableReader& t) {
            "part '" + name + "' belongs to a " + g->second + ": its properties come from there");
   auto& pp = ctx.model.parts[static_cast<std::size_t>(p)];
   ctx.part_defined[static_cast<std::size_t>(p)] = 1;
-  if (ctx.part_kind[name] == PartKind::Solid) {
+  if (ctx.part_kind[name] == PartKind::Shell) {
+    pp.shell_thickness = t.number("thickness", Range::positive());
+    pp.shell_integration_points = static_cast<int>(t.integer("integration_points", 2, 1, 5));
+    pp.hourglass_stiffness = t.number("hourglass_stiffness", 0.1, Range::closed(0, 1));
+    pp.material_axes = read_axes(t);
+    const bool has_mat = t.has("material"), has_law = t.has("membrane_law");
+    if (has_mat == has_law)
+      t.fail(has_mat ? "membrane_law" : "material",
+             "a shell part takes either `material` (elastic_isotropic, plane stress) or "
+             "`membrane_law` (a [[membrane_law]] name), not both and not neither");
+    if (has_mat) {
+      const std::string mat = t.string("material");
+      if (!ctx.materials.count(mat)) t.fail("material", "no [[material]] named '" + mat + "'");
+      pp.material = ctx.materials[mat];
+    } else {
+      const std::string law = t.string("membrane_law");
+      if (!ctx.membrane_laws.count(law))
+        t.fail("membrane_law", "no [[membrane_law]] named '" + law + "'");
+      pp.membrane_law = ctx.membrane_laws[law];
+    }
+  } else if (ctx.part_kind[name] == PartKind::Solid) {
     const std::string mat = t.string("material");
     if (!ctx.materials.count(mat)) t.fail("material", "no [[material]] named '" + mat + "'");
     pp.material = ctx.materials[mat];
@@ -112,6 +132,27 @@ std::unique_ptr<SolidMaterial> CaseTypeRegistry::read_material(const TableReader
   t.fail("type", "no reader for type '" + type + "'");  // not reached: choice() checked it
 }
 
+void CaseTypeRegistry::add_membrane_law_type(std::string type, MembraneLawReader reader) {
+  for (const auto& [known, r] : membrane_laws_)
+    if (known == type) throw std::logic_error("membrane law type '" + type + "' registered twice");
+  membrane_laws_.emplace_back(std::move(type), std::move(reader));
+}
+
+std::unique_ptr<MembraneLaw> CaseTypeRegistry::read_membrane_law(const TableReader& t,
+                                                                 const std::string& name) const {
+  std::vector<std::string> types;
+  for (const auto& [type, r] : membrane_laws_) types.push_back(type);
+  if (types.empty()) t.fail("type", "no membrane law types are registered");
+  const std::string type = t.choice("type", types, "");
+  for (const auto& [known, reader] : membrane_laws_)
+    if (known == type) try {
+        return reader(t, name);
+      } catch (const std::invalid_argument& e) {
+        t.fail("type", e.what());
+      }
+  t.fail("type", "no reader for type '" + type + "'");
+}
+
 void register_fem_case_types(CaseTypeRegistry& registry) {
   registry.add_material_type("elastic_isotropic", read_elastic_isotropic);
   registry.add_material_type("elastic_orthotropic", read_elastic_orthotropic);
@@ -132,6 +173,15 @@ void read_bar_laws(CaseReadContext& ctx) {
     if (ctx.bar_laws.count(name)) t.fail("name", "duplicate bar law '" + name + "'");
     ctx.model.bar_laws.push_back(read_bar_law(t, name));
     ctx.bar_laws[name] = static_cast<int>(ctx.model.bar_laws.size()) - 1;
+  }
+}
+
+void read_membrane_laws(CaseReadContext& ctx) {
+  for (const auto& t : ctx.root.tables("membrane_law")) {
+    const std::string name = t.string("name");
+    if (ctx.membrane_laws.count(name)) t.fail("name", "duplicate membrane law '" + name + "'");
+    ctx.model.membrane_laws.push_back(ctx.types.read_membrane_law(t, name));
+    ctx.membrane_laws[name] = static_cast<int>(ctx.model.membrane_laws.size()) - 1;
   }
 }
 

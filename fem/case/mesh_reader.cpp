@@ -26,9 +26,12 @@ int axis_index(const TableReader& t, std::string_view key, const std::string& va
 // The part of a block or line: created on first use; a part holds hexahedra or bars, not both.
 int use_part(CaseReadContext& ctx, const TableReader& t, const std::string& part, PartKind kind) {
   const auto it = ctx.part_kind.find(part);
-  if (it != ctx.part_kind.end() && it->second != kind)
-    t.fail("part",
-           "'" + part + "' already holds " + (kind == PartKind::Solid ? "bars" : "hexahedra"));
+  if (it != ctx.part_kind.end() && it->second != kind) {
+    const char* held = it->second == PartKind::Solid ? "hexahedra"
+                       : it->second == PartKind::Bar ? "bars"
+                                                     : "shells";
+    t.fail("part", "'" + part + "' already holds " + held + ": a part holds one element kind");
+  }
   ctx.part_kind[part] = kind;
   Mesh& mesh = ctx.model.mesh;
   const int p = mesh.find_part(part);
@@ -75,6 +78,44 @@ void read_line(CaseReadContext& ctx, const TableReader& l) {
     for (std::size_t k = 0; k < 3; ++k) mesh.coords.push_back(a[k] + s * (bnd[k] - a[k]));
   }
   for (int i = 0; i < n_div; ++i) append_bar(mesh, first + i, first + i + 1, p);
+}
+
+// A flat rectangle of shells: corner `origin`, sides `size` along the two axes of `plane`,
+// normal along the third (counter-clockwise about it).
+void read_plate(CaseReadContext& ctx, const TableReader& t) {
+  const std::string part = t.string("part");
+  const auto origin = t.vec3_or("origin", {0, 0, 0});
+  const auto size = t.numbers("size", Range::positive(), 2);
+  if (size.size() != 2) t.fail("size", "must hold exactly 2 lengths [a, b] (m)");
+  const auto divv = t.numbers("divisions", Range::closed(1, 1e6), 2);
+  if (divv.size() != 2) t.fail("divisions", "must hold exactly 2 integers [na, nb]");
+  std::array<int, 2> div{};
+  for (std::size_t k = 0; k < 2; ++k) {
+    if (divv[k] != std::floor(divv[k])) t.fail("divisions", "must be integers");
+    div[k] = divv[k] == 1 ? 1
+                          : std::max(1, static_cast<int>(std::lround(divv[k] * ctx.resolution_factor)));
+  }
+  const std::string plane = t.choice("plane", {"xy", "yz", "zx"}, "xy");
+  const int a0 = plane == "xy" ? 0 : plane == "yz" ? 1 : 2, a1 = (a0 + 1) % 3;
+  Mesh& mesh = ctx.model.mesh;
+  require_model_fits(t.file().string(), t.key_path("divisions"),
+                     static_cast<double>(mesh.n_nodes()) + (div[0] + 1.0) * (div[1] + 1.0),
+                     static_cast<double>(mesh.elements(ElementKind::Hex8).size()),
+                     static_cast<double>(mesh.elements(ElementKind::Bar2).size()));
+  const int p = use_part(ctx, t, part, PartKind::Shell);
+  const auto first = static_cast<std::int32_t>(mesh.n_nodes());
+  for (int j = 0; j <= div[1]; ++j)
+    for (int i = 0; i <= div[0]; ++i) {
+      std::array<double, 3> c = origin;
+      c[static_cast<std::size_t>(a0)] += size[0] * i / div[0];
+      c[static_cast<std::size_t>(a1)] += size[1] * j / div[1];
+      for (double v : c) mesh.coords.push_back(v);
+    }
+  auto id = [&](int i, int j) { return first + i + (div[0] + 1) * j; };
+  ElementSet& shells = mesh.elements(ElementKind::Quad4);
+  for (int j = 0; j < div[1]; ++j)
+    for (int i = 0; i < div[0]; ++i)
+      shells.add({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)}, p);
 }
 
 // Selection criteria, each narrowing `keep`.
@@ -182,8 +223,10 @@ void read_mesh_blocks(CaseReadContext& ctx, const TableReader& m) {
   ctx.resolution_factor = resolution_factor(ctx.resolution);
   const auto blocks = m.tables("block");
   const auto lines = m.tables("line");
+  const auto plates = m.tables("plate");
   for (const auto& b : blocks) read_block(ctx, b);
   for (const auto& l : lines) read_line(ctx, l);
+  for (const auto& p : plates) read_plate(ctx, p);
 }
 
 std::vector<std::int32_t> finish_mesh(CaseReadContext& ctx) {

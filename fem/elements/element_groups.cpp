@@ -9,6 +9,9 @@ std::unique_ptr<ElementGroup> make_hex8_group(const Model&, const ElementSet&, i
 std::unique_ptr<ElementGroup> make_bar2_group(const Model&, const ElementSet&, int,
                                               const std::vector<std::size_t>&, const double*);
 
+std::unique_ptr<ElementGroup> make_quad4_group(const Model&, const ElementSet&, int,
+                                               const std::vector<std::size_t>&, const double*);
+
 std::unique_ptr<ElementGroup> make_element_group(const Model& model, const ElementSet& set,
                                                  int part, const std::vector<std::size_t>& elements,
                                                  const double* x_ref) {
@@ -17,6 +20,8 @@ std::unique_ptr<ElementGroup> make_element_group(const Model& model, const Eleme
       return make_hex8_group(model, set, part, elements, x_ref);
     case ElementKind::Bar2:
       return make_bar2_group(model, set, part, elements, x_ref);
+    case ElementKind::Quad4:
+      return make_quad4_group(model, set, part, elements, x_ref);
   }
   return nullptr;
 }

@@ -11,27 +11,28 @@ namespace ncfsim::fem {
 
 /// Kinds in the order the mesh keeps its element sets and the solver its groups (renumbering and
 /// the order in which element forces are summed depend on it: append new kinds at the end).
-enum class ElementKind : std::uint8_t { Hex8, Bar2 };
-constexpr std::array<ElementKind, 2> kElementKinds{ElementKind::Hex8, ElementKind::Bar2};
+enum class ElementKind : std::uint8_t { Hex8, Bar2, Quad4 };
+constexpr std::array<ElementKind, 3> kElementKinds{ElementKind::Hex8, ElementKind::Bar2,
+                                                   ElementKind::Quad4};
 constexpr int kMaxNodesPerElement = 8;
 
 constexpr int nodes_per_element(ElementKind k) {
-  constexpr int n[] = {8, 2};
+  constexpr int n[] = {8, 2, 4};
   return n[static_cast<int>(k)];
 }
 /// Noun for messages ("hexahedron 12 at ...").
 constexpr const char* element_noun(ElementKind k) {
-  constexpr const char* n[] = {"hexahedron", "bar"};
+  constexpr const char* n[] = {"hexahedron", "bar", "shell"};
   return n[static_cast<int>(k)];
 }
 /// Plural noun for counts in messages ("1200 hexahedra").
 constexpr const char* element_plural(ElementKind k) {
-  constexpr const char* n[] = {"hexahedra", "bars"};
+  constexpr const char* n[] = {"hexahedra", "bars", "shells"};
   return n[static_cast<int>(k)];
 }
 /// Short name for output and summaries ("hex8").
 constexpr const char* element_kind_name(ElementKind k) {
-  constexpr const char* n[] = {"hex8", "bar2"};
+  constexpr const char* n[] = {"hex8", "bar2", "quad4"};
   return n[static_cast<int>(k)];
 }
 

@@ -11,6 +11,8 @@ struct ElementEnergyIncrement {
   double internal = 0;       // stress power incl. physical stabilisation
   double stabilisation = 0;  // part of `internal` carried by the stabilisation
   double hourglass = 0;      // viscous (non-physical) hourglass work
+  double kinetic = 0;        // change of the kinetic energy groups hold themselves (the
+                             // rotations of shell nodes), part of the kinetic energy
 };
 
 struct StableStep {

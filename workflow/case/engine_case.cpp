@@ -208,6 +208,7 @@ EngineCase load_engine_case(const std::filesystem::path& file,
   ec.resolution = ctx.resolution;
   fem::read_materials(ctx);
   fem::read_bar_laws(ctx);
+  fem::read_membrane_laws(ctx);
   fem::read_parts(ctx);
   if (imported) impact::assign_impregnated_parts(ctx, import);
   ec.fabric_summaries = drape::assign_fabric_parts(ctx, fabrics);

@@ -1,0 +1,530 @@
+// Belytschko-Tsay shells: geometry, mass, stable step and the batched force kernel
+// (fem/elements/shell4_block.hpp has the formulation).
+#include "fem/elements/shell4_block.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+
+#include "fem/errors.hpp"
+
+namespace ncfsim::fem {
+
+namespace {
+
+// Elements per pass: the geometry of a chunk stays in L1 between the pass that hands the
+// membrane law its deformation gradients and the pass that makes the forces.
+constexpr std::size_t kChunk = 64;
+// Drilling spring per node: this share of the membrane stiffness times the area (N m/rad).
+constexpr double kDrillingRatio = 1e-3;
+
+// The co-rotational frame of a shell with corners p[I] = (x, y, z): normal along the cross
+// product of the diagonals, axis 1 on the bisector of the diagonals (the same frame whichever
+// node comes first), local corner coordinates about the centre, projected area, and the
+// centre gradients B[a][I] = dN_I/dx_a. False for a degenerate shell.
+struct ShellFrame {
+  double e[3][3];  // e[k] = axis k (global components)
+  double xl[4], yl[4];
+  double area;
+  double B[2][4];
+};
+
+bool shell_frame(const double p[4][3], ShellFrame& f) {
+  double a[3], b[3], n[3];
+  for (int k = 0; k < 3; ++k) a[k] = p[2][k] - p[0][k], b[k] = p[3][k] - p[1][k];
+  n[0] = a[1] * b[2] - a[2] * b[1];
+  n[1] = a[2] * b[0] - a[0] * b[2];
+  n[2] = a[0] * b[1] - a[1] * b[0];
+  const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  const double na = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+  if (!(nn > 0) || !(na > 0) || !(nb > 0)) return false;
+  double e1[3], n1 = 0;
+  for (int k = 0; k < 3; ++k) {
+    f.e[2][k] = n[k] / nn;
+    e1[k] = a[k] / na - b[k] / nb;
+    n1 += e1[k] * e1[k];
+  }
+  n1 = std::sqrt(n1);
+  if (!(n1 > 0)) return false;
+  for (int k = 0; k < 3; ++k) f.e[0][k] = e1[k] / n1;
+  const double* e3 = f.e[2];
+  const double* ea = f.e[0];
+  f.e[1][0] = e3[1] * ea[2] - e3[2] * ea[1];
+  f.e[1][1] = e3[2] * ea[0] - e3[0] * ea[2];
+  f.e[1][2] = e3[0] * ea[1] - e3[1] * ea[0];
+  double c[3];
+  for (int k = 0; k < 3; ++k) c[k] = 0.25 * (p[0][k] + p[1][k] + p[2][k] + p[3][k]);
+  for (int I = 0; I < 4; ++I) {
+    double d[3];
+    for (int k = 0; k < 3; ++k) d[k] = p[I][k] - c[k];
+    f.xl[I] = d[0] * f.e[0][0] + d[1] * f.e[0][1] + d[2] * f.e[0][2];
+    f.yl[I] = d[0] * f.e[1][0] + d[1] * f.e[1][1] + d[2] * f.e[1][2];
+  }
+  const double* x = f.xl;
+  const double* y = f.yl;
+  const double two_a =
+      x[0] * (y[1] - y[3]) + x[1] * (y[2] - y[0]) + x[2] * (y[3] - y[1]) + x[3] * (y[0] - y[2]);
+  if (!(two_a > 0)) return false;
+  f.area = 0.5 * two_a;
+  const double s = 1.0 / two_a;
+  f.B[0][0] = (y[1] - y[3]) * s, f.B[0][1] = (y[2] - y[0]) * s;
+  f.B[0][2] = (y[3] - y[1]) * s, f.B[0][3] = (y[0] - y[2]) * s;
+  f.B[1][0] = (x[3] - x[1]) * s, f.B[1][1] = (x[0] - x[2]) * s;
+  f.B[1][2] = (x[1] - x[3]) * s, f.B[1][3] = (x[2] - x[0]) * s;
+  return true;
+}
+
+void gather(const Shell4Block& b, std::size_t e, const double* x, double p[4][3]) {
+  for (std::size_t I = 0; I < 4; ++I) {
+    const auto node = static_cast<std::size_t>(b.conn[I * b.n + e]);
+    for (int k = 0; k < 3; ++k) p[I][k] = x[3 * node + static_cast<std::size_t>(k)];
+  }
+}
+
+// F = dx/dX at the centre from the current local corners and the reference gradients.
+void inplane_gradient(const Shell4Block& b, std::size_t e, const ShellFrame& f, double F[4]) {
+  F[0] = F[1] = F[2] = F[3] = 0;
+  for (std::size_t I = 0; I < 4; ++I) {
+    const double b1 = b.b0[I * b.n + e], b2 = b.b0[(4 + I) * b.n + e];
+    F[0] += f.xl[I] * b1, F[1] += f.xl[I] * b2;
+    F[2] += f.yl[I] * b1, F[3] += f.yl[I] * b2;
+  }
+}
+
+// Symmetric 2x2 tensor (11, 22, 12) rotated: R^T T R (to the reference frame) or R T R^T.
+inline void to_reference(double c, double s, const double t[3], double out[3]) {
+  out[0] = c * c * t[0] + 2 * c * s * t[2] + s * s * t[1];
+  out[1] = s * s * t[0] - 2 * c * s * t[2] + c * c * t[1];
+  out[2] = -c * s * t[0] + (c * c - s * s) * t[2] + c * s * t[1];
+}
+inline void to_current(double c, double s, const double t[3], double out[3]) {
+  to_reference(c, -s, t, out);
+}
+
+// Gauss-Legendre points and weights on [-1, 1].
+struct GaussRule {
+  int n;
+  double xi[5], w[5];
+};
+GaussRule gauss_rule(int n) {
+  switch (n) {
+    case 1:
+      return {1, {0}, {2}};
+    case 2:
+      return {2, {-1 / std::sqrt(3.0), 1 / std::sqrt(3.0)}, {1, 1}};
+    case 3:
+      return {3, {-std::sqrt(0.6), 0, std::sqrt(0.6)}, {5.0 / 9, 8.0 / 9, 5.0 / 9}};
+    case 4: {
+      const double a = std::sqrt(3.0 / 7 - 2.0 / 7 * std::sqrt(1.2)),
+                   c = std::sqrt(3.0 / 7 + 2.0 / 7 * std::sqrt(1.2));
+      const double wa = (18 + std::sqrt(30.0)) / 36, wc = (18 - std::sqrt(30.0)) / 36;
+      return {4, {-c, -a, a, c}, {wc, wa, wa, wc}};
+    }
+    default: {
+      const double a = std::sqrt(5 - 2 * std::sqrt(10.0 / 7)) / 3,
+                   c = std::sqrt(5 + 2 * std::sqrt(10.0 / 7)) / 3;
+      const double wa = (322 + 13 * std::sqrt(70.0)) / 900, wc = (322 - 13 * std::sqrt(70.0)) / 900;
+      return {5, {-c, -a, 0, a, c}, {wc, wa, 128.0 / 225, wa, wc}};
+    }
+  }
+}
+
+[[noreturn]] void degenerate(const Shell4Block& b, std::size_t e, const char* where) {
+  std::ostringstream os;
+  os << "shell " << b.user_id[e] << " of part " << b.part << " is degenerate " << where
+     << " (zero area, or its diagonals parallel)";
+  throw NumericalError(os.str());
+}
+
+}  // namespace
+
+void shell4_initialise(Shell4Block& b, const double* x_ref, const double axis[3]) {
+  const std::size_t n = b.n;
+  b.area0.assign(n, 0);
+  b.b0.assign(8 * n, 0);
+  b.axes0.assign(4 * n, 0);
+  if (b.mass_scale.size() != n) b.mass_scale.assign(n, 1.0);
+  for (auto* v : {&b.strain, &b.curvature, &b.resultant, &b.moment}) v->assign(3 * n, 0);
+  for (auto* v : {&b.shear, &b.shear_force}) v->assign(2 * n, 0);
+  b.hg_force.assign(5 * n, 0);
+  b.drill_moment.assign(4 * n, 0);
+  b.polar_angle.assign(n, 0);
+  const MembraneLaw* law = b.section.law;
+  b.history.assign(law ? static_cast<std::size_t>(law->n_history()) * n : 0, 0);
+
+  const double t = b.section.thickness;
+  if (law) {
+    b.membrane_stiffness = law->membrane_stiffness();
+    b.bending_stiffness = law->bending_stiffness();
+    // Transverse shear as in a plate of that bending stiffness with G = E / 2 (nu = 0): stiff
+    // enough that the fabric bends as a Kirchhoff plate, no stiffer.
+    b.shear_stiffness = 5.0 * b.bending_stiffness / (t * t);
+    b.areal_density = law->areal_density();
+    b.poisson = 0;
+  } else {
+    const double E = b.section.youngs_modulus, nu = b.section.poisson_ratio;
+    b.membrane_stiffness = E * t / (1 - nu * nu);
+    b.bending_stiffness = E * t * t * t / (12 * (1 - nu * nu));
+    b.shear_stiffness = 5.0 / 6.0 * E / (2 * (1 + nu)) * t;
+    b.areal_density = b.section.density * t;
+    b.poisson = nu;
+  }
+
+  for (std::size_t e = 0; e < n; ++e) {
+    double p[4][3];
+    gather(b, e, x_ref, p);
+    ShellFrame f;
+    if (!shell_frame(p, f)) degenerate(b, e, "in the reference shape");
+    b.area0[e] = f.area;
+    for (std::size_t I = 0; I < 4; ++I) {
+      b.b0[I * n + e] = f.B[0][I];
+      b.b0[(4 + I) * n + e] = f.B[1][I];
+    }
+    // Material axis 1 projected on the element's plane, axis 2 a right angle from it.
+    double a1 = axis[0] * f.e[0][0] + axis[1] * f.e[0][1] + axis[2] * f.e[0][2];
+    double a2 = axis[0] * f.e[1][0] + axis[1] * f.e[1][1] + axis[2] * f.e[1][2];
+    const double na = std::hypot(a1, a2);
+    if (!(na > 1e-6)) {
+      std::ostringstream os;
+      os << "shell " << b.user_id[e] << " of part " << b.part
+         << ": the material axis 1 is normal to the shell (give an axis in its plane)";
+      throw InputError("", "part.material_axis_1", os.str());
+    }
+    a1 /= na, a2 /= na;
+    b.axes0[e] = a1, b.axes0[n + e] = a2, b.axes0[2 * n + e] = -a2, b.axes0[3 * n + e] = a1;
+  }
+}
+
+void shell4_lumped_mass(const Shell4Block& b, double* mass) {
+  for (std::size_t e = 0; e < b.n; ++e) {
+    const double m = 0.25 * b.areal_density * b.mass_scale[e] * b.area0[e];
+    for (std::size_t I = 0; I < 4; ++I) {
+      const auto node = static_cast<std::size_t>(b.conn[I * b.n + e]);
+      for (int k = 0; k < 3; ++k) mass[3 * node + static_cast<std::size_t>(k)] += m;
+    }
+  }
+}
+
+void shell4_rotary_inertia(const Shell4Block& b, double* inertia) {
+  const double t = b.section.thickness;
+  for (std::size_t e = 0; e < b.n; ++e) {
+    const double m = 0.25 * b.areal_density * b.mass_scale[e] * b.area0[e];
+    const double r2 = t * t / 12 + b.area0[e] / 8;
+    for (std::size_t I = 0; I < 4; ++I) inertia[b.conn[I * b.n + e]] += m * r2;
+  }
+}
+
+void shell4_element_steps(const Shell4Block& b, const double* x, std::vector<double>& dt) {
+  dt.assign(b.n, 0.0);
+  for (std::size_t e = 0; e < b.n; ++e) {
+    double p[4][3];
+    gather(b, e, x, p);
+    ShellFrame f;
+    if (!shell_frame(p, f)) continue;  // step 0: the solver stops and names the element
+    double lmin = 1e300, lmax = 0;
+    for (int I = 0; I < 4; ++I) {
+      const int J = (I + 1) % 4;
+      const double l = std::hypot(f.xl[J] - f.xl[I], f.yl[J] - f.yl[I]);
+      lmin = std::min(lmin, l), lmax = std::max(lmax, l);
+    }
+    const double L = std::min(lmin, f.area / lmax);
+    dt[e] = L * std::sqrt(b.areal_density * b.mass_scale[e] / b.membrane_stiffness);
+  }
+}
+
+void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, const double* w,
+                            double dt, double* fo, double* mo, ElementEnergyIncrement& energy,
+                            StableStep& step) {
+  const std::size_t n = b.n;
+  const MembraneLaw* law = b.section.law;
+  const double t = b.section.thickness;
+  const double Ks = b.shear_stiffness, D = b.bending_stiffness, nu = b.poisson;
+  const double hg = b.section.hourglass_stiffness;
+  const GaussRule gr = gauss_rule(std::clamp(b.section.integration_points, 1, 5));
+  const double E = b.section.youngs_modulus;
+  const double Q11 = law ? 0.0 : E / (1 - nu * nu), Q12 = nu * Q11, G2 = E / (1 + nu);
+  double w_int = 0, w_hg = 0;
+
+  ShellFrame fr[kChunk];
+  double Fc[4][kChunk], Nc[3][kChunk];
+  bool ok[kChunk];
+  std::vector<double> hist_scratch;
+  for (std::size_t e0 = 0; e0 < n; e0 += kChunk) {
+    const std::size_t m = std::min(kChunk, n - e0);
+    // Pass 1: frames and in-plane deformation gradients.
+    for (std::size_t j = 0; j < m; ++j) {
+      const std::size_t e = e0 + j;
+      double p[4][3];
+      gather(b, e, x, p);
+      ok[j] = shell_frame(p, fr[j]);
+      double F[4] = {1, 0, 0, 1};
+      if (ok[j]) inplane_gradient(b, e, fr[j], F);
+      for (int k = 0; k < 4; ++k) Fc[k][j] = F[k];
+    }
+    if (law) {
+      double axes[4][kChunk];
+      for (int k = 0; k < 4; ++k)
+        for (std::size_t j = 0; j < m; ++j)
+          axes[k][j] = b.axes0[static_cast<std::size_t>(k) * n + e0 + j];
+      const auto nh = static_cast<std::size_t>(law->n_history());
+      hist_scratch.resize(nh * kChunk);
+      for (std::size_t r = 0; r < nh; ++r)
+        for (std::size_t j = 0; j < m; ++j)
+          hist_scratch[r * kChunk + j] = b.history[r * n + e0 + j];
+      MembraneBatch mb;
+      mb.n = m, mb.stride = kChunk, mb.F = &Fc[0][0], mb.axes = &axes[0][0];
+      mb.resultant = &Nc[0][0], mb.history = hist_scratch.data();
+      law->update(mb);
+      for (std::size_t r = 0; r < nh; ++r)
+        for (std::size_t j = 0; j < m; ++j)
+          b.history[r * n + e0 + j] = hist_scratch[r * kChunk + j];
+    }
+    // Pass 2: strains, section forces, nodal forces and moments.
+    for (std::size_t j = 0; j < m; ++j) {
+      const std::size_t e = e0 + j;
+      if (!ok[j]) {
+        take_smaller(step, StableStep{0.0, b.user_id[e], ElementKind::Quad4});
+        continue;
+      }
+      const ShellFrame& f = fr[j];
+      const double A = f.area;
+      const double F[4] = {Fc[0][j], Fc[1][j], Fc[2][j], Fc[3][j]};
+      std::size_t node[4];
+      double vl[4][3], wl[4][3];
+      for (std::size_t I = 0; I < 4; ++I) {
+        node[I] = static_cast<std::size_t>(b.conn[I * n + e]);
+        const double* vi = v + 3 * node[I];
+        const double* wi = w + 3 * node[I];
+        for (int k = 0; k < 3; ++k)
+          vl[I][k] = vi[0] * f.e[k][0] + vi[1] * f.e[k][1] + vi[2] * f.e[k][2];
+        for (int k = 0; k < 3; ++k)
+          wl[I][k] = wi[0] * f.e[k][0] + wi[1] * f.e[k][1] + wi[2] * f.e[k][2];
+      }
+      // Material rotation relative to the frame: the polar angle of F, kept continuous; the
+      // increments are rotated back with its mid-step value.
+      const double th_old = b.polar_angle[e];
+      const double th =
+          th_old + std::remainder(std::atan2(F[2] - F[1], F[0] + F[3]) - th_old, 2 * M_PI);
+      b.polar_angle[e] = th;
+      const double cm = std::cos(0.5 * (th + th_old)), sm = std::sin(0.5 * (th + th_old));
+      const double c = std::cos(th), s = std::sin(th);
+
+      // Rate quantities over the step (current frame).
+      double dk[3] = {0, 0, 0}, dg[2] = {0, 0}, dq[5] = {0, 0, 0, 0, 0};
+      double hx = 0, hy = 0;
+      const double h[4] = {1, -1, 1, -1};
+      for (int I = 0; I < 4; ++I) hx += h[I] * f.xl[I], hy += h[I] * f.yl[I];
+      double gam[4], bb = 0, spin = 0;
+      for (int I = 0; I < 4; ++I) spin += 0.5 * (f.B[0][I] * vl[I][1] - f.B[1][I] * vl[I][0]);
+      for (int I = 0; I < 4; ++I) {
+        const double b1 = f.B[0][I], b2 = f.B[1][I];
+        bb += b1 * b1 + b2 * b2;
+        dk[0] += b1 * wl[I][1];
+        dk[1] -= b2 * wl[I][0];
+        dk[2] += 0.5 * (b2 * wl[I][1] - b1 * wl[I][0]);
+        dg[0] += b1 * vl[I][2] + 0.25 * wl[I][1];
+        dg[1] += b2 * vl[I][2] - 0.25 * wl[I][0];
+        gam[I] = 0.25 * (h[I] - hx * b1 - hy * b2);
+        dq[0] += gam[I] * vl[I][0], dq[1] += gam[I] * vl[I][1], dq[2] += gam[I] * vl[I][2];
+        dq[3] += gam[I] * wl[I][0], dq[4] += gam[I] * wl[I][1];
+      }
+      for (double& d : dk) d *= dt;
+      for (double& d : dg) d *= dt;
+      for (double& d : dq) d *= dt;
+      // ... to the reference frame.
+      double dkr[3];
+      to_reference(cm, sm, dk, dkr);
+      const double dgr[2] = {cm * dg[0] + sm * dg[1], -sm * dg[0] + cm * dg[1]};
+      const double dqr[5] = {cm * dq[0] + sm * dq[1], -sm * dq[0] + cm * dq[1], dq[2],
+                             cm * dq[3] + sm * dq[4], -sm * dq[3] + cm * dq[4]};
+
+      double kap[3], gr2[2];
+      for (int k = 0; k < 3; ++k)
+        kap[k] = b.curvature[static_cast<std::size_t>(k) * n + e] + dkr[k];
+      for (int k = 0; k < 2; ++k) gr2[k] = b.shear[static_cast<std::size_t>(k) * n + e] + dgr[k];
+      const double Em[3] = {0.5 * (F[0] * F[0] + F[2] * F[2] - 1),
+                            0.5 * (F[1] * F[1] + F[3] * F[3] - 1),
+                            0.5 * (F[0] * F[1] + F[2] * F[3])};
+      const double J = F[0] * F[3] - F[1] * F[2];
+
+      // Section forces: membrane N (reference, 2nd Piola-Kirchhoff; and current), moments M
+      // (reference), transverse shear Q (reference).
+      double Nr[3], Ncur[3], Mr[3];
+      if (law) {
+        Ncur[0] = Nc[0][j], Ncur[1] = Nc[1][j], Ncur[2] = Nc[2][j];
+        // pull back: Nr = J F^-1 N F^-T
+        const double iJ = 1.0 / J;
+        const double Fi[4] = {F[3] * iJ, -F[1] * iJ, -F[2] * iJ, F[0] * iJ};
+        const double a11 = Fi[0] * Ncur[0] + Fi[1] * Ncur[2],
+                     a12 = Fi[0] * Ncur[2] + Fi[1] * Ncur[1];
+        const double a21 = Fi[2] * Ncur[0] + Fi[3] * Ncur[2],
+                     a22 = Fi[2] * Ncur[2] + Fi[3] * Ncur[1];
+        Nr[0] = J * (a11 * Fi[0] + a12 * Fi[1]);
+        Nr[1] = J * (a21 * Fi[2] + a22 * Fi[3]);
+        Nr[2] = J * (a11 * Fi[2] + a12 * Fi[3]);
+        Mr[0] = D * kap[0], Mr[1] = D * kap[1], Mr[2] = D * kap[2];
+      } else {
+        Nr[0] = Nr[1] = Nr[2] = Mr[0] = Mr[1] = Mr[2] = 0;
+        for (int k = 0; k < gr.n; ++k) {
+          const double z = 0.5 * t * gr.xi[k], wz = 0.5 * t * gr.w[k];
+          const double e11 = Em[0] + z * kap[0], e22 = Em[1] + z * kap[1], e12 = Em[2] + z * kap[2];
+          const double S[3] = {Q11 * e11 + Q12 * e22, Q12 * e11 + Q11 * e22, G2 * e12};
+          for (int c3 = 0; c3 < 3; ++c3) Nr[c3] += wz * S[c3], Mr[c3] += wz * z * S[c3];
+        }
+        // push forward: N = F Nr F^T / J
+        const double iJ = 1.0 / J;
+        const double a11 = F[0] * Nr[0] + F[1] * Nr[2], a12 = F[0] * Nr[2] + F[1] * Nr[1];
+        const double a21 = F[2] * Nr[0] + F[3] * Nr[2], a22 = F[2] * Nr[2] + F[3] * Nr[1];
+        Ncur[0] = iJ * (a11 * F[0] + a12 * F[1]);
+        Ncur[1] = iJ * (a21 * F[2] + a22 * F[3]);
+        Ncur[2] = iJ * (a11 * F[2] + a12 * F[3]);
+      }
+      const double Qr[2] = {Ks * gr2[0], Ks * gr2[1]};
+      const double kmem = hg * b.membrane_stiffness * A * bb / 8;
+      const double kben = hg * D * A * bb / 16;
+      const double kw = hg * Ks * t * t * bb / 12;
+      const double kq[5] = {kmem, kmem, kw, kben, kben};
+      double Qh[5];
+      for (int k = 0; k < 5; ++k) {
+        const double old = b.hg_force[static_cast<std::size_t>(k) * n + e];
+        Qh[k] = old + kq[k] * dqr[k];
+        w_hg += 0.5 * (old + Qh[k]) * dqr[k];
+      }
+      // Work over the step (trapezoid in the reference frame).
+      double wm = 0, wb = 0, ws = 0;
+      for (int k = 0; k < 3; ++k) {
+        const auto ke = static_cast<std::size_t>(k) * n + e;
+        const double fac = k == 2 ? 2.0 : 1.0;
+        wm += fac * 0.5 * (b.resultant[ke] + Nr[k]) * (Em[k] - b.strain[ke]);
+        wb += fac * 0.5 * (b.moment[ke] + Mr[k]) * dkr[k];
+        b.strain[ke] = Em[k], b.curvature[ke] = kap[k];
+        b.resultant[ke] = Nr[k], b.moment[ke] = Mr[k];
+      }
+      for (int k = 0; k < 2; ++k) {
+        const auto ke = static_cast<std::size_t>(k) * n + e;
+        ws += 0.5 * (b.shear_force[ke] + Qr[k]) * dgr[k];
+        b.shear[ke] = gr2[k], b.shear_force[ke] = Qr[k];
+      }
+      for (int k = 0; k < 5; ++k) b.hg_force[static_cast<std::size_t>(k) * n + e] = Qh[k];
+      // Drilling: each node's rotation about the normal is tied to the shell's in-plane spin by
+      // a weak spring (without it that rotation has no stiffness, and the inertia it is given
+      // gathers energy from a vibrating curved shell).
+      const double kdr = kDrillingRatio * b.membrane_stiffness * A;
+      double Md[4], Msum = 0;
+      for (int I = 0; I < 4; ++I) {
+        const auto ke = static_cast<std::size_t>(I) * n + e;
+        const double d = (wl[I][2] - spin) * dt;
+        Md[I] = b.drill_moment[ke] + kdr * d;
+        w_hg += 0.5 * (b.drill_moment[ke] + Md[I]) * d;
+        b.drill_moment[ke] = Md[I];
+        Msum += Md[I];
+      }
+      w_int += b.area0[e] * wm + A * (wb + ws);
+
+      // Current-frame section forces.
+      double Mc[3];
+      to_current(c, s, Mr, Mc);
+      const double Qc[2] = {c * Qr[0] - s * Qr[1], s * Qr[0] + c * Qr[1]};
+      const double Hc[5] = {c * Qh[0] - s * Qh[1], s * Qh[0] + c * Qh[1], Qh[2],
+                            c * Qh[3] - s * Qh[4], s * Qh[3] + c * Qh[4]};
+      for (int I = 0; I < 4; ++I) {
+        const double b1 = f.B[0][I], b2 = f.B[1][I], g = gam[I];
+        const double fl[3] = {A * (b1 * Ncur[0] + b2 * Ncur[2]) + g * Hc[0] + 0.5 * b2 * Msum,
+                              A * (b2 * Ncur[1] + b1 * Ncur[2]) + g * Hc[1] - 0.5 * b1 * Msum,
+                              A * (b1 * Qc[0] + b2 * Qc[1]) + g * Hc[2]};
+        const double ml[3] = {A * (-b2 * Mc[1] - b1 * Mc[2] - 0.25 * Qc[1]) + g * Hc[3],
+                              A * (b1 * Mc[0] + b2 * Mc[2] + 0.25 * Qc[0]) + g * Hc[4], Md[I]};
+        double* fi = fo + 3 * node[I];
+        double* mi = mo + 3 * node[I];
+        for (int k = 0; k < 3; ++k) {
+          fi[k] -= fl[0] * f.e[0][k] + fl[1] * f.e[1][k] + fl[2] * f.e[2][k];
+          mi[k] -= ml[0] * f.e[0][k] + ml[1] * f.e[1][k] + ml[2] * f.e[2][k];
+        }
+      }
+      // Stable step at the current shape.
+      double lmin = 1e300, lmax = 0;
+      for (int I = 0; I < 4; ++I) {
+        const int Jn = (I + 1) % 4;
+        const double l = std::hypot(f.xl[Jn] - f.xl[I], f.yl[Jn] - f.yl[I]);
+        lmin = std::min(lmin, l), lmax = std::max(lmax, l);
+      }
+      const double L = std::min(lmin, A / lmax);
+      const double dte = L * std::sqrt(b.areal_density * b.mass_scale[e] / b.membrane_stiffness);
+      if (dte < step.dt) step = {dte, b.user_id[e], ElementKind::Quad4};
+    }
+  }
+  energy.internal += w_int + w_hg;
+  energy.stabilisation += w_hg;
+}
+
+void shell4_output_fields(const Shell4Block& b, const double* x, double* shear_angle_deg,
+                          double* membrane_force, double* bending_moment, double* fibre_direction) {
+  const std::size_t n = b.n;
+  std::array<double, 2> fam{0.0, 0.5 * M_PI};
+  if (b.section.law) fam = b.section.law->fibre_angles();
+  for (std::size_t e = 0; e < n; ++e) {
+    double p[4][3];
+    gather(b, e, x, p);
+    ShellFrame f;
+    const double nan = std::nan("");
+    if (!shell_frame(p, f)) {
+      if (shear_angle_deg) shear_angle_deg[e] = nan;
+      if (membrane_force) std::fill(membrane_force + 6 * e, membrane_force + 6 * e + 6, nan);
+      if (bending_moment) std::fill(bending_moment + 6 * e, bending_moment + 6 * e + 6, nan);
+      if (fibre_direction) std::fill(fibre_direction + 3 * e, fibre_direction + 3 * e + 3, nan);
+      continue;
+    }
+    double F[4];
+    inplane_gradient(b, e, f, F);
+    const double a1 = b.axes0[e], a2 = b.axes0[n + e];
+    double dir[2][2];
+    for (int k = 0; k < 2; ++k) {
+      const double ck = std::cos(fam[static_cast<std::size_t>(k)]),
+                   sk = std::sin(fam[static_cast<std::size_t>(k)]);
+      const double A1 = ck * a1 - sk * a2, A2 = sk * a1 + ck * a2;  // family k, reference
+      const double d1 = F[0] * A1 + F[1] * A2, d2 = F[2] * A1 + F[3] * A2;
+      const double nd = std::hypot(d1, d2);
+      dir[k][0] = d1 / nd, dir[k][1] = d2 / nd;
+    }
+    if (shear_angle_deg) {
+      const double cosang = std::clamp(dir[0][0] * dir[1][0] + dir[0][1] * dir[1][1], -1.0, 1.0);
+      shear_angle_deg[e] = 90.0 - std::acos(cosang) * 180.0 / M_PI;
+    }
+    if (fibre_direction)
+      for (int k = 0; k < 3; ++k)
+        fibre_direction[3 * e + static_cast<std::size_t>(k)] =
+            dir[0][0] * f.e[0][k] + dir[0][1] * f.e[1][k];
+    // Tensors to global axes: T = sum_ab T_ab e_a e_b (in-plane a, b).
+    const double th = b.polar_angle[e];
+    const double c = std::cos(th), s = std::sin(th);
+    auto to_global = [&](const double tc[3], double* out) {
+      const double T[2][2] = {{tc[0], tc[2]}, {tc[2], tc[1]}};
+      const int ij[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+      for (int q = 0; q < 6; ++q) {
+        double sum = 0;
+        for (int a = 0; a < 2; ++a)
+          for (int bq = 0; bq < 2; ++bq) sum += T[a][bq] * f.e[a][ij[q][0]] * f.e[bq][ij[q][1]];
+        out[q] = sum;
+      }
+    };
+    if (membrane_force) {
+      const double J = F[0] * F[3] - F[1] * F[2];
+      const double Nr[3] = {b.resultant[e], b.resultant[n + e], b.resultant[2 * n + e]};
+      const double a11 = F[0] * Nr[0] + F[1] * Nr[2], a12 = F[0] * Nr[2] + F[1] * Nr[1];
+      const double a21 = F[2] * Nr[0] + F[3] * Nr[2], a22 = F[2] * Nr[2] + F[3] * Nr[1];
+      const double Nc[3] = {(a11 * F[0] + a12 * F[1]) / J, (a21 * F[2] + a22 * F[3]) / J,
+                            (a11 * F[2] + a12 * F[3]) / J};
+      to_global(Nc, membrane_force + 6 * e);
+    }
+    if (bending_moment) {
+      const double Mr[3] = {b.moment[e], b.moment[n + e], b.moment[2 * n + e]};
+      double Mc[3];
+      to_current(c, s, Mr, Mc);
+      to_global(Mc, bending_moment + 6 * e);
+    }
+  }
+}
+
+}  // namespace ncfsim::fem
