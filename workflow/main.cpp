@@ -17,6 +17,7 @@
 #include "workflow/calibrate/calibrate_stitch.hpp"
 #include "workflow/calibrate/calibrate_tow_bending.hpp"
 #include "workflow/case/engine_case.hpp"
+#include "workflow/compare/compare.hpp"
 #include "workflow/figures/figures.hpp"
 #include "workflow/report/report.hpp"
 #include "workflow/run/engine_run.hpp"
@@ -174,6 +175,39 @@ int main(int argc, char** argv) {
   cal_bend->add_option("-o,--output", tb.out_dir,
                        "Output folder (default tow_bending_calibration)");
 
+  wf::CompareOptions cmp;
+  std::vector<double> ring_centre, ring_axis, ring_zero;
+  auto* compare = app.add_subcommand(
+      "compare",
+      "Shear rings (the Fig. 18 measure) of drape runs and imported macro results side by side: "
+      "quadrant maxima, RMS and largest differences, one plot");
+  compare
+      ->add_option("sources", cmp.sources,
+                   "Run folders (meso drape, kinematic_drape, macro drape, workflow) and macro "
+                   "results (.vtu, .csv); LABEL=PATH names one")
+      ->required();
+  compare->add_option("-o,--output", cmp.out_dir, "Output folder (default comparison)");
+  compare->add_option("--field", cmp.import.field,
+                      "Shear-angle field / column of the imported files (deg; default: the first "
+                      "of shear_angle_deg, shear_deg, shear_angle, shear)");
+  compare->add_option("--tolerance", cmp.import.tolerance,
+                      "Point clouds: search radius about each ring ray, m (default 1.5 x the "
+                      "median point spacing)");
+  compare->add_option("--ring-height", cmp.import.ring.height,
+                      "Ring height above the reference plane, m (default 0.04)");
+  compare->add_option("--ring-centre", ring_centre, "Point of the axis in the plane: x,y,z (m)")
+      ->expected(3)
+      ->delimiter(',');
+  compare->add_option("--ring-axis", ring_axis, "Ring axis: x,y,z (default 0,0,1)")
+      ->expected(3)
+      ->delimiter(',');
+  compare->add_option("--ring-zero-direction", ring_zero, "Azimuth 0, the wale: x,y,z (1,0,0)")
+      ->expected(3)
+      ->delimiter(',');
+  compare->add_option("--ring-step", cmp.import.ring.step_deg, "Azimuth step, deg (default 1)");
+  compare->add_flag("--overwrite", cmp.overwrite,
+                    "Write into a folder that holds files ncfsim did not write");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -203,6 +237,14 @@ int main(int argc, char** argv) {
       call.options.force_stages = force_stages;
       call.options.overwrite = overwrite;
       return wf::run_stage(call);
+    }
+    if (*compare) {
+      cmp.verbosity = verbosity;
+      if (!ring_centre.empty()) cmp.import.ring.centre = ncfsim::fem::V3::at(ring_centre.data());
+      if (!ring_axis.empty()) cmp.import.ring.axis = ncfsim::fem::V3::at(ring_axis.data());
+      if (!ring_zero.empty())
+        cmp.import.ring.zero_direction = ncfsim::fem::V3::at(ring_zero.data());
+      return wf::compare_rings(cmp);
     }
     if (*cal_stitch) {
       sc.sign = shear == "negative" ? ncfsim::drape::ShearSign::Negative
