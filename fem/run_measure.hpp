@@ -18,8 +18,9 @@
 
 namespace ncfsim::fem {
 
-/// A cell field a measure adds to the result frames: values [n_components * (n_hex + n_bar)],
-/// hexahedra first, then bars (the results files' cell order); NaN where it does not apply.
+/// A cell field a measure adds to the result frames: values [n_components * (n_hex + n_bar +
+/// n_quad)], hexahedra first, then bars, then shells (the results files' cell order); NaN where
+/// it does not apply.
 struct MeasureCellField {
   std::string name;
   int n_components = 1;

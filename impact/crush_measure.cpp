@@ -185,10 +185,8 @@ void CrushMeasure::add_summary(const fem::ExplicitSolver& s, nlohmann::json& sum
 
 void CrushMeasure::add_frame_fields(const fem::ExplicitSolver& s,
                                     std::vector<fem::MeasureCellField>& fields) const {
-  std::size_t n_hex = 0, n_bar = 0;
-  for (const auto& g : s.groups())
-    (g->kind() == fem::ElementKind::Hex8 ? n_hex : n_bar) += g->size();
-  const std::size_t n_cells = n_hex + n_bar;
+  std::size_t n_cells = 0;  // every kind's cells, in group (= kind) order
+  for (const auto& g : s.groups()) n_cells += g->size();
   std::vector<fem::MeasureCellField> out;
   for (int m = 0; m < kModes; ++m)
     out.push_back({std::string("damage_") + kModeNames[static_cast<std::size_t>(m)], 1,

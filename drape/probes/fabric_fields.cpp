@@ -173,8 +173,9 @@ FabricFields::Values FabricFields::values(const fem::ExplicitSolver& s) const {
 
 void FabricFields::add_frame_fields(const fem::ExplicitSolver& s,
                                     std::vector<fem::MeasureCellField>& fields) const {
-  const std::size_t n_cells =
-      s.n_elements(fem::ElementKind::Hex8) + s.n_elements(fem::ElementKind::Bar2);
+  const std::size_t n_cells = s.n_elements(fem::ElementKind::Hex8) +
+                              s.n_elements(fem::ElementKind::Bar2) +
+                              s.n_elements(fem::ElementKind::Quad4);
   auto field = [&](const char* name) -> std::vector<double>& {
     for (auto& f : fields)
       if (f.name == name) return f.values;

@@ -13,6 +13,9 @@ namespace ncfsim::fem {
 
 namespace {
 
+// sqrt(a^2 + b^2) without hypot's overflow care (lengths here are far from overflow).
+inline double len2(double a, double b) { return std::sqrt(a * a + b * b); }
+
 // Elements per pass: the geometry of a chunk stays in L1 between the pass that hands the
 // membrane law its deformation gradients and the pass that makes the forces.
 constexpr std::size_t kChunk = 64;
@@ -150,7 +153,8 @@ void shell4_initialise(Shell4Block& b, const double* x_ref, const double axis[3]
   for (auto* v : {&b.shear, &b.shear_force}) v->assign(2 * n, 0);
   b.hg_force.assign(5 * n, 0);
   b.drill_moment.assign(4 * n, 0);
-  b.polar_angle.assign(n, 0);
+  b.polar_angle.assign(2 * n, 0);
+  for (std::size_t e = 0; e < n; ++e) b.polar_angle[2 * e] = 1;
   const MembraneLaw* law = b.section.law;
   b.history.assign(law ? static_cast<std::size_t>(law->n_history()) * n : 0, 0);
 
@@ -185,7 +189,7 @@ void shell4_initialise(Shell4Block& b, const double* x_ref, const double axis[3]
     // Material axis 1 projected on the element's plane, axis 2 a right angle from it.
     double a1 = axis[0] * f.e[0][0] + axis[1] * f.e[0][1] + axis[2] * f.e[0][2];
     double a2 = axis[0] * f.e[1][0] + axis[1] * f.e[1][1] + axis[2] * f.e[1][2];
-    const double na = std::hypot(a1, a2);
+    const double na = len2(a1, a2);
     if (!(na > 1e-6)) {
       std::ostringstream os;
       os << "shell " << b.user_id[e] << " of part " << b.part
@@ -226,7 +230,7 @@ void shell4_element_steps(const Shell4Block& b, const double* x, std::vector<dou
     double lmin = 1e300, lmax = 0;
     for (int I = 0; I < 4; ++I) {
       const int J = (I + 1) % 4;
-      const double l = std::hypot(f.xl[J] - f.xl[I], f.yl[J] - f.yl[I]);
+      const double l = len2(f.xl[J] - f.xl[I], f.yl[J] - f.yl[I]);
       lmin = std::min(lmin, l), lmax = std::max(lmax, l);
     }
     const double L = std::min(lmin, f.area / lmax);
@@ -302,14 +306,15 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
         for (int k = 0; k < 3; ++k)
           wl[I][k] = wi[0] * f.e[k][0] + wi[1] * f.e[k][1] + wi[2] * f.e[k][2];
       }
-      // Material rotation relative to the frame: the polar angle of F, kept continuous; the
-      // increments are rotated back with its mid-step value.
-      const double th_old = b.polar_angle[e];
-      const double th =
-          th_old + std::remainder(std::atan2(F[2] - F[1], F[0] + F[3]) - th_old, 2 * M_PI);
-      b.polar_angle[e] = th;
-      const double cm = std::cos(0.5 * (th + th_old)), sm = std::sin(0.5 * (th + th_old));
-      const double c = std::cos(th), s = std::sin(th);
+      // Material rotation relative to the frame: the polar rotation of F, cos and sin straight
+      // from F (no trigonometry); the increments are rotated back with its mid-step value, the
+      // bisector of the old and new rotations.
+      const double rr = len2(F[0] + F[3], F[2] - F[1]);
+      const double c = (F[0] + F[3]) / rr, s = (F[2] - F[1]) / rr;
+      const double c_old = b.polar_angle[2 * e], s_old = b.polar_angle[2 * e + 1];
+      const double rm = len2(c + c_old, s + s_old);
+      const double cm = rm > 1e-12 ? (c + c_old) / rm : c, sm = rm > 1e-12 ? (s + s_old) / rm : s;
+      b.polar_angle[2 * e] = c, b.polar_angle[2 * e + 1] = s;
 
       // Rate quantities over the step (current frame).
       double dk[3] = {0, 0, 0}, dg[2] = {0, 0}, dq[5] = {0, 0, 0, 0, 0};
@@ -447,7 +452,7 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
       double lmin = 1e300, lmax = 0;
       for (int I = 0; I < 4; ++I) {
         const int Jn = (I + 1) % 4;
-        const double l = std::hypot(f.xl[Jn] - f.xl[I], f.yl[Jn] - f.yl[I]);
+        const double l = len2(f.xl[Jn] - f.xl[I], f.yl[Jn] - f.yl[I]);
         lmin = std::min(lmin, l), lmax = std::max(lmax, l);
       }
       const double L = std::min(lmin, A / lmax);
@@ -485,7 +490,7 @@ void shell4_output_fields(const Shell4Block& b, const double* x, double* shear_a
                    sk = std::sin(fam[static_cast<std::size_t>(k)]);
       const double A1 = ck * a1 - sk * a2, A2 = sk * a1 + ck * a2;  // family k, reference
       const double d1 = F[0] * A1 + F[1] * A2, d2 = F[2] * A1 + F[3] * A2;
-      const double nd = std::hypot(d1, d2);
+      const double nd = len2(d1, d2);
       dir[k][0] = d1 / nd, dir[k][1] = d2 / nd;
     }
     if (shear_angle_deg) {
@@ -497,8 +502,7 @@ void shell4_output_fields(const Shell4Block& b, const double* x, double* shear_a
         fibre_direction[3 * e + static_cast<std::size_t>(k)] =
             dir[0][0] * f.e[0][k] + dir[0][1] * f.e[1][k];
     // Tensors to global axes: T = sum_ab T_ab e_a e_b (in-plane a, b).
-    const double th = b.polar_angle[e];
-    const double c = std::cos(th), s = std::sin(th);
+    const double c = b.polar_angle[2 * e], s = b.polar_angle[2 * e + 1];
     auto to_global = [&](const double tc[3], double* out) {
       const double T[2][2] = {{tc[0], tc[2]}, {tc[2], tc[1]}};
       const int ij[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};

@@ -31,10 +31,11 @@ std::vector<drape::FabricEntry> read_mesh(CaseReadContext& ctx) {
                   "missing (required section [mesh] with [[mesh.block]] or [[mesh.line]] entries)");
   const TableReader m = ctx.root.required_table("mesh");
   fem::read_mesh_blocks(ctx, m);
-  if (m.tables("block").empty() && m.tables("line").empty() && !m.has("fabric"))
+  if (m.tables("block").empty() && m.tables("line").empty() && m.tables("plate").empty() &&
+      !m.has("fabric"))
     m.fail("block",
-           "the mesh has no elements: give at least one [[mesh.block]], [[mesh.line]] or "
-           "[[mesh.fabric]]");
+           "the mesh has no elements: give at least one [[mesh.block]], [[mesh.line]], "
+           "[[mesh.plate]] or [[mesh.fabric]]");
   auto fabrics = drape::read_fabrics(ctx, m);
   const auto new_of_old = fem::finish_mesh(ctx);
   drape::renumber_fabrics(ctx, fabrics, new_of_old);

@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "fem/elements/element_fields.hpp"
+#include "fem/elements/shell4_block.hpp"
 
 namespace ncfsim::workflow {
 
@@ -39,6 +40,16 @@ fem::io::ResultMesh result_mesh(const fem::ExplicitSolver& s) {
       m.bar_material.push_back(law);
     }
   }
+  for (const auto& b : s.blocks<fem::Shell4Block>()) {
+    for (std::size_t e = 0; e < b.n; ++e) {
+      for (std::size_t I = 0; I < 4; ++I) m.quad4.push_back(b.conn[I * b.n + e]);
+      m.quad_part.push_back(b.part);
+      m.quad_user_id.push_back(b.user_id[e]);
+      // Elastic sections name a [[material]]; membrane-law sections are not in material_names.
+      m.quad_material.push_back(b.section.law ? -1 : b.material_index);
+      m.quad_thickness.push_back(b.section.thickness);
+    }
+  }
   return m;
 }
 
@@ -54,13 +65,17 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
   for (std::size_t d = 0; d < 3 * nn; ++d) fr.displacement[d] = X[d] - X0[d];
   fr.fields.push_back({"velocity", false, 3, std::vector<double>(Vv.data(), Vv.data() + 3 * nn)});
   const std::size_t nh = s.n_elements(fem::ElementKind::Hex8),
-                    nb = s.n_elements(fem::ElementKind::Bar2);
+                    nb = s.n_elements(fem::ElementKind::Bar2),
+                    nq = s.n_elements(fem::ElementKind::Quad4), nc = nh + nb + nq;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  fem::io::FrameField stress{"stress", true, 6, std::vector<double>(6 * (nh + nb), nan)};
-  fem::io::FrameField vm{"von_mises_stress", true, 1, std::vector<double>(nh + nb, nan)};
-  fem::io::FrameField fibre{"fibre_direction", true, 3, std::vector<double>(3 * (nh + nb), nan)};
-  fem::io::FrameField axial{"axial_force", true, 1, std::vector<double>(nh + nb, nan)};
-  fem::io::FrameField bstrain{"axial_strain", true, 1, std::vector<double>(nh + nb, nan)};
+  fem::io::FrameField stress{"stress", true, 6, std::vector<double>(6 * nc, nan)};
+  fem::io::FrameField vm{"von_mises_stress", true, 1, std::vector<double>(nc, nan)};
+  fem::io::FrameField fibre{"fibre_direction", true, 3, std::vector<double>(3 * nc, nan)};
+  fem::io::FrameField axial{"axial_force", true, 1, std::vector<double>(nc, nan)};
+  fem::io::FrameField bstrain{"axial_strain", true, 1, std::vector<double>(nc, nan)};
+  fem::io::FrameField shear{"shear_angle_deg", true, 1, std::vector<double>(nc, nan)};
+  fem::io::FrameField membrane{"membrane_force", true, 6, std::vector<double>(6 * nc, nan)};
+  fem::io::FrameField moment{"bending_moment", true, 6, std::vector<double>(6 * nc, nan)};
   std::size_t off = 0;
   for (const auto& b : s.blocks<fem::Hex8Block>()) {
     fem::hex8_output_fields(b, X.data(), stress.values.data() + 6 * off, vm.values.data() + off,
@@ -74,14 +89,25 @@ fem::io::Frame make_frame(const fem::ExplicitSolver& s) {
     }
     off += b.n;
   }
+  for (const auto& b : s.blocks<fem::Shell4Block>()) {
+    fem::shell4_output_fields(b, X.data(), shear.values.data() + off,
+                              membrane.values.data() + 6 * off, moment.values.data() + 6 * off,
+                              fibre.values.data() + 3 * off);
+    off += b.n;
+  }
   if (nh) {
     fr.fields.push_back(std::move(stress));
     fr.fields.push_back(std::move(vm));
-    fr.fields.push_back(std::move(fibre));
+  }
+  if (nh || nq) fr.fields.push_back(std::move(fibre));
+  if (nq) {
+    fr.fields.push_back(std::move(shear));
+    fr.fields.push_back(std::move(membrane));
+    fr.fields.push_back(std::move(moment));
   }
   if (nh && s.erosion_enabled()) {
     // 1 where a hexahedron was eroded (ParaView: threshold it away)
-    fem::io::FrameField eroded{"eroded", true, 1, std::vector<double>(nh + nb, 0.0)};
+    fem::io::FrameField eroded{"eroded", true, 1, std::vector<double>(nc, 0.0)};
     std::size_t o = 0;
     for (const auto& b : s.blocks<fem::Hex8Block>()) {
       if (b.n_eroded)
@@ -122,6 +148,16 @@ fem::Mesh mesh_from_stage_frame(const fem::io::StageFrame& frame, bool deformed)
                 static_cast<std::int32_t>(rm.bar2[2 * e + 1])},
                rm.bar_part[e]);
     bars.user_id = rm.bar_user_id;
+  }
+  if (const std::size_t nq = rm.n_quad(); nq) {
+    fem::ElementSet& shells = m.elements(fem::ElementKind::Quad4);
+    for (std::size_t e = 0; e < nq; ++e)
+      shells.add({static_cast<std::int32_t>(rm.quad4[4 * e]),
+                  static_cast<std::int32_t>(rm.quad4[4 * e + 1]),
+                  static_cast<std::int32_t>(rm.quad4[4 * e + 2]),
+                  static_cast<std::int32_t>(rm.quad4[4 * e + 3])},
+                 rm.quad_part[e]);
+    if (rm.quad_user_id.size() == nq) shells.user_id = rm.quad_user_id;
   }
   m.fill_default_user_ids();  // whatever the file did not hold
   return m;
