@@ -119,6 +119,22 @@ TEST(CliCompare, FishnetReadBackAsAVtuGivesItsOwnRing) {
     EXPECT_TRUE(s.contains("figure_error"));
   else
     EXPECT_TRUE(fs::exists(out / "figures/ring_shear_compared.png"));
+  // A workflow folder gives the rings of its stages; the same net read twice is left out.
+  const fs::path wf = fresh_dir("compare_workflow");
+  fs::create_directories(wf);
+  fs::copy(fish, wf / "fish", fs::copy_options::recursive);
+  std::ofstream(wf / "summary.json")
+      << R"({"stage": "workflow", "stages": [{"name": "fishnet", "kind": "kinematic_drape",
+             "folder": "fish"}]})";
+  const fs::path out2 = fresh_dir("compare_out_wf");
+  r = run_cli({"compare", "wf=" + wf.string(), fish.string(), "-o", out2.string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto s2 = json::parse(slurp(out2 / "summary.json"));
+  ASSERT_EQ(s2["sources"].size(), 1u) << r.output;
+  EXPECT_EQ(s2["sources"][0]["label"], "wf/fishnet");
+  EXPECT_NE(r.output.find("equals one already read; left out"), std::string::npos) << r.output;
+  fs::remove_all(wf);
+  fs::remove_all(out2);
   // A rerun into the same folder replaces it (the manifest), the output folder is no source.
   r = run_cli({"compare", fish.string(), "-o", out.string()});
   EXPECT_EQ(r.code, 0) << r.output;

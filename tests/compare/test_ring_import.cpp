@@ -304,6 +304,25 @@ TEST(RingImport, PairDifferenceOfTwoRings) {
   EXPECT_EQ(d.max_at_azimuth_deg, 0.0);
 }
 
+// A macro drape's folder (ring_shear.csv column macro_shear_deg, summary.json
+// macro_max_shear_deg_q1..q4) reads as a macro source with its summary keys beside.
+TEST(RingImport, MacroRunFolderReadsAsMacro) {
+  const fs::path dir = temp("macro_run");
+  fs::create_directories(dir);
+  std::string csv = "azimuth_deg,macro_shear_deg,hit,x_m,y_m,z_m\n";
+  for (int k = 0; k < 360; ++k)
+    csv += std::to_string(k) + "," + std::to_string(gamma_at(k * kPi / 180)) + ",1,0,0,0.04\n";
+  std::ofstream(dir / "ring_shear.csv") << csv;
+  std::ofstream(dir / "summary.json") << R"({"stage": "engine", "macro_max_shear_deg_q1": 18.0})";
+  const auto src = workflow::read_run_folder(dir, "macro");
+  ASSERT_EQ(src.size(), 1u);
+  EXPECT_EQ(src[0].kind, "macro");
+  EXPECT_EQ(src[0].column, "macro_shear_deg");
+  EXPECT_EQ(src[0].summary_maxima["macro_max_shear_deg_q1"], 18.0);
+  EXPECT_NEAR(drape::quadrant_maxima(src[0].ring).max_shear_deg[0], kA + kB, 1e-5);
+  fs::remove_all(dir);
+}
+
 TEST(RingImportBadInput, EveryBadFileNamesItselfAndWhy) {
   workflow::RingImportOptions opt;
   opt.ring = ring40();
