@@ -69,6 +69,25 @@ Grid lat_long(double r, double t0, double t1, int nt, int np) {
   return g;
 }
 
+// The dome as a cloud of about 1 mm spacing with gamma, and an outer sheet 5 mm further out with
+// 99 deg (the rays meet it second: it must not count).
+std::pair<std::vector<V3>, std::vector<double>> dome_cloud() {
+  std::vector<V3> pts;
+  std::vector<double> v;
+  const double h = 1e-3;
+  for (double t = 0.2; t < 1.2; t += h / kR) {
+    const int np = static_cast<int>(2 * kPi * kR * std::sin(t) / h);
+    for (int j = 0; j < np; ++j) {
+      const double p = 2 * kPi * (j + 0.5 * t / (h / kR)) / np;
+      pts.push_back(sphere(kR, t, p));
+      v.push_back(gamma_at(p));
+      pts.push_back(sphere(kR + 5e-3, t, p));
+      v.push_back(99.0);
+    }
+  }
+  return {pts, v};
+}
+
 drape::RingSpec ring40() {
   drape::RingSpec r;
   r.height = 0.04;
@@ -140,16 +159,9 @@ TEST(RingImportVerification, Cos2FieldOnADomeCloudGivesItsQuadrantMaxima) {
   {
     std::ofstream out(csv);
     out << "# analytic dome\nX,Y,Z,shear_angle_deg\n";
-    const double h = 1e-3;
-    for (double t = 0.2; t < 1.2; t += h / kR) {
-      const int np = static_cast<int>(2 * kPi * kR * std::sin(t) / h);
-      for (int j = 0; j < np; ++j) {
-        const double p = 2 * kPi * (j + 0.5 * t / (h / kR)) / np;
-        const V3 x = sphere(kR, t, p), y = sphere(kR + 5e-3, t, p);
-        out << x.x << "," << x.y << "," << x.z << "," << gamma_at(p) << "\n";
-        out << y.x << "," << y.y << "," << y.z << ",99\n";
-      }
-    }
+    const auto [pts, v] = dome_cloud();
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      out << pts[i].x << "," << pts[i].y << "," << pts[i].z << "," << v[i] << "\n";
   }
   workflow::RingImportOptions opt;
   opt.ring = ring40();
@@ -171,6 +183,27 @@ TEST(RingImportVerification, Cos2FieldOnADomeCloudGivesItsQuadrantMaxima) {
   EXPECT_NEAR(q.max_shear_deg[2], kA + kB, 0.05);
   EXPECT_NEAR(q.max_shear_deg[3], kA, 0.05);
   fs::remove(csv);
+}
+
+// The same cloud as a .vtu of vertex cells with gamma as a cell field: read as a cloud, the same
+// ring (the fit is the same; within 0.05 deg of gamma).
+TEST(RingImportVerification, VertexVtuIsReadAsACloud) {
+  const auto [pts, v] = dome_cloud();
+  std::vector<std::pair<int, std::vector<std::int32_t>>> cells;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    cells.push_back({VTK_VERTEX, {static_cast<std::int32_t>(i)}});
+  const fs::path vtu = temp("dome_vertices.vtu");
+  write_vtu(vtu, pts, cells, {{"shear", true, 1, v}});
+  workflow::RingImportOptions opt;
+  opt.ring = ring40();
+  const auto r = workflow::import_ring(vtu, opt);
+  EXPECT_EQ(r.method, "points");
+  EXPECT_EQ(r.location, "cell");
+  for (const auto& s : r.ring) {
+    ASSERT_TRUE(s.hit);
+    EXPECT_NEAR(s.shear_deg, gamma_at(s.azimuth_deg * kPi / 180), 0.05) << s.azimuth_deg;
+  }
+  fs::remove(vtu);
 }
 
 // A quadrilateral shell mesh of the dome in a .vtu with gamma as a point field: the import is the
@@ -231,8 +264,16 @@ TEST(RingImport, HexCellFieldReadsAsTheMesoMeasure) {
       cv.push_back(layer < 2 ? gamma_at(c) : std::nan(""));
       cells.push_back({VTK_HEXAHEDRON, {h.begin(), h.end()}});
     }
+  // A line cell (a stitch bar) with a value at two surface nodes: lines take no part.
+  std::size_t at_ring = 0;  // a hexahedron of the inner layer that the ring's plane cuts
+  while (!(pts[static_cast<std::size_t>(conn[at_ring][0])].z > 0.04 &&
+           pts[static_cast<std::size_t>(conn[at_ring][3])].z < 0.04))
+    ++at_ring;
+  cells.push_back({VTK_LINE, {conn[at_ring][0], conn[at_ring][3]}});
+  cv.push_back(1000.0);
   const fs::path vtu = temp("dome_hex.vtu");
   write_vtu(vtu, pts, cells, {{"shear_angle_deg", true, 1, cv}});
+  cv.pop_back();
   workflow::RingImportOptions opt;
   opt.ring = ring40();
   const auto r = workflow::import_ring(vtu, opt);

@@ -369,9 +369,11 @@ ImportedRing import_vtu(const fs::path& file, const RingImportOptions& opt) {
                                          {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
   std::vector<Tri> tri;
   std::map<std::vector<std::int32_t>, std::pair<int, std::vector<std::int32_t>>> faces;
-  std::vector<double> sum(pts.size(), 0.0);
-  std::vector<int> count(pts.size(), 0);
-  std::vector<std::int32_t> vertex_cells;  // cells of dimension 0 (a point cloud as vertices)
+  // Cell values summed at the points: of the surface's cells (2D, 3D), and of vertex cells (a
+  // point cloud as vertices); lines (a meso frame's stitch bars) take no part.
+  std::vector<double> sum(pts.size(), 0.0), vertex_sum(pts.size(), 0.0);
+  std::vector<int> count(pts.size(), 0), vertex_count(pts.size(), 0);
+  std::vector<std::int32_t> vertex_cells;  // cells of dimension 0
   vtkNew<vtkGenericCell> cell;
   for (vtkIdType c = 0; c < n_cells; ++c) {
     const double cv = f.on_cells ? values[static_cast<std::size_t>(c)] : 0.0;
@@ -381,10 +383,11 @@ ImportedRing import_vtu(const fs::path& file, const RingImportOptions& opt) {
     std::vector<std::int32_t> ids(static_cast<std::size_t>(cell->GetNumberOfPoints()));
     for (std::size_t k = 0; k < ids.size(); ++k)
       ids[k] = static_cast<std::int32_t>(cell->GetPointId(static_cast<vtkIdType>(k)));
-    if (f.on_cells)
+    if (f.on_cells && dim != 1)
       for (auto id : ids) {
-        sum[static_cast<std::size_t>(id)] += cv;
-        ++count[static_cast<std::size_t>(id)];
+        const auto i = static_cast<std::size_t>(id);
+        (dim == 0 ? vertex_sum : sum)[i] += cv;
+        ++(dim == 0 ? vertex_count : count)[i];
       }
     if (dim == 0) vertex_cells.push_back(static_cast<std::int32_t>(c));
     if (dim == 2) {
@@ -429,11 +432,14 @@ ImportedRing import_vtu(const fs::path& file, const RingImportOptions& opt) {
   for (const auto& [key, fc] : faces)
     if (fc.first == 1) add_polygon(fc.second, tri);
 
-  // Values at the points: the point field, or the mean of the cells' values at each point.
+  // Values at the points: the point field, or the mean of the cells' values at each point (the
+  // surface's cells; without a surface, the vertex cells').
   std::vector<double> node_value = f.on_cells ? std::vector<double>(pts.size(), kNaN) : values;
-  if (f.on_cells)
+  if (f.on_cells) {
+    if (tri.empty()) sum.swap(vertex_sum), count.swap(vertex_count);
     for (std::size_t i = 0; i < pts.size(); ++i)
       if (count[i] > 0) node_value[i] = sum[i] / count[i];
+  }
 
   if (!tri.empty()) {
     out.method = "surface";

@@ -9,7 +9,7 @@
 //   ray-triangle measure, drape::ring_shear, on its triangles (quadrilaterals split n0 n1 n2 /
 //   n0 n2 n3 as the meso measure splits the faces of its hexahedra); a cell field is first
 //   averaged to the points over the cells with a finite value (drape::element_to_node_mean's
-//   rule), and only those cells make the surface;
+//   rule; line cells take no part), and only those cells make the surface;
 // * a point cloud (a CSV, a .vtu without 2D/3D cells): for each azimuth the points within
 //   `tolerance` of the ray, of the sheet nearest the axis (distance along the ray within
 //   `tolerance` of the nearest), give the value at the ray by a weighted linear least-squares fit
