@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "drape/case/drape_case.hpp"
+#include "drape/fabric_membrane.hpp"
 #include "drape/tow_material.hpp"
 #include "fem/case/model_size.hpp"
 #include "fem/errors.hpp"
@@ -202,8 +203,48 @@ void assign_stitch_parts(fem::CaseReadContext& ctx, const FabricEntry& fe) {
 
 }  // namespace
 
+namespace {
+
+// [[membrane_law]] type = "fabric": the macro membrane law of the fabric (shells).
+std::unique_ptr<fem::MembraneLaw> read_fabric_membrane(const TableReader& t,
+                                                       const std::string& name) {
+  FabricMembraneConstants c;
+  c.areal_density = t.number("areal_density", Range::positive());
+  const auto ang = t.has("fibre_angles_deg")
+                       ? t.numbers("fibre_angles_deg", Range::closed(-180, 180), 2)
+                       : std::vector<double>{45.0, -45.0};
+  if (ang.size() != 2) t.fail("fibre_angles_deg", "must hold exactly 2 angles (deg)");
+  c.fibre_angles = {ang[0] * M_PI / 180, ang[1] * M_PI / 180};
+  c.fibre_tension_stiffness = t.number("fibre_tension_stiffness", Range::positive());
+  c.fibre_compression_ratio = t.number("fibre_compression_ratio", 1e-3, Range::closed(0, 1));
+  c.bending_stiffness = t.number("bending_stiffness", Range::positive());
+  auto curve = [&](const char* akey, const char* fkey) {
+    const auto a = t.numbers(akey, Range::closed(0, 89), 1);
+    const auto f = t.numbers(fkey, {}, 1);
+    if (a.size() != f.size()) t.fail(fkey, std::string("needs as many values as `") + akey + "`");
+    std::vector<double> rad(a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) rad[i] = a[i] * M_PI / 180;
+    try {
+      return ShearCurve(rad, f);
+    } catch (const std::invalid_argument& e) {
+      t.fail(akey, e.what());
+    }
+  };
+  c.positive = curve("shear_angle_deg", "shear_force");
+  if (t.has("negative_shear_angle_deg") || t.has("negative_shear_force"))
+    c.negative = curve("negative_shear_angle_deg", "negative_shear_force");
+  try {
+    return std::make_unique<FabricMembraneLaw>(name, std::move(c));
+  } catch (const std::invalid_argument& e) {
+    t.fail("type", e.what());
+  }
+}
+
+}  // namespace
+
 void register_drape_case_types(fem::CaseTypeRegistry& registry) {
   registry.add_material_type("tow_biphase", read_tow_biphase);
+  registry.add_membrane_law_type("fabric", read_fabric_membrane);
 }
 
 std::vector<FabricEntry> read_fabrics(fem::CaseReadContext& ctx, const TableReader& m) {
