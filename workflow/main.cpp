@@ -192,7 +192,9 @@ int main(int argc, char** argv) {
                       "of shear_angle_deg, shear_deg, shear_angle, shear)");
   compare->add_option("--tolerance", cmp.import.tolerance,
                       "Point clouds: search radius about each ring ray, m (default 1.5 x the "
-                      "median point spacing)");
+                      "median point spacing, at most 10 mm)");
+  compare->add_option("--length-scale", cmp.import.length_scale,
+                      "Imported files: factor from their length unit to m (default 1; 1e-3: mm)");
   compare->add_option("--ring-height", cmp.import.ring.height,
                       "Ring height above the reference plane, m (default 0.04)");
   compare->add_option("--ring-centre", ring_centre, "Point of the axis in the plane: x,y,z (m)")

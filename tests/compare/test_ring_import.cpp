@@ -185,10 +185,11 @@ TEST(RingImportVerification, Cos2FieldOnADomeCloudGivesItsQuadrantMaxima) {
   fs::remove(csv);
 }
 
-// The same cloud as a .vtu of vertex cells with gamma as a cell field: read as a cloud, the same
-// ring (the fit is the same; within 0.05 deg of gamma).
-TEST(RingImportVerification, VertexVtuIsReadAsACloud) {
-  const auto [pts, v] = dome_cloud();
+// The same cloud as a .vtu of vertex cells in mm (--length-scale 1e-3) with gamma as a cell
+// field: read as a cloud, the same ring (within 0.05 deg of gamma).
+TEST(RingImportVerification, VertexVtuInMillimetresIsReadAsACloud) {
+  auto [pts, v] = dome_cloud();
+  for (auto& p : pts) p = 1e3 * p;
   std::vector<std::pair<int, std::vector<std::int32_t>>> cells;
   for (std::size_t i = 0; i < pts.size(); ++i)
     cells.push_back({VTK_VERTEX, {static_cast<std::int32_t>(i)}});
@@ -196,6 +197,7 @@ TEST(RingImportVerification, VertexVtuIsReadAsACloud) {
   write_vtu(vtu, pts, cells, {{"shear", true, 1, v}});
   workflow::RingImportOptions opt;
   opt.ring = ring40();
+  opt.length_scale = 1e-3;
   const auto r = workflow::import_ring(vtu, opt);
   EXPECT_EQ(r.method, "points");
   EXPECT_EQ(r.location, "cell");
@@ -378,6 +380,10 @@ TEST(RingImportBadInput, EveryBadFileNamesItselfAndWhy) {
   std::ofstream(csv) << "x,y,z,shear_deg\n0.05,0,0.0,1\n0.06,0,0.0,1\n";  // far below the ring
   e = error_of(csv, opt);
   EXPECT_NE(e.find("no azimuth of the ring"), std::string::npos) << e;
+  opt.length_scale = 0;
+  e = error_of(csv, opt);
+  EXPECT_NE(e.find("--length-scale"), std::string::npos) << e;
+  opt.length_scale = 1;
   std::ofstream(csv) << "x,y,z,shear_deg\n0.05,0,abc,1\n";
   e = error_of(csv, opt);
   EXPECT_NE(e.find("line 2"), std::string::npos) << e;

@@ -175,7 +175,8 @@ ImportedRing import_csv(const fs::path& file, const RingImportOptions& opt) {
                         header[static_cast<std::size_t>(c)], t, nan_ok ? "" : "finite "));
       return v;
     };
-    pts.push_back({num(cx, false), num(cy, false), num(cz, false)});
+    const double k = opt.length_scale;
+    pts.push_back({k * num(cx, false), k * num(cy, false), k * num(cz, false)});
     val.push_back(num(cs, true));  // NaN: no value at that point (skipped)
   }
   if (pts.empty()) throw InputError(file.string(), "", "holds a header but no rows");
@@ -354,7 +355,8 @@ ImportedRing import_vtu(const fs::path& file, const RingImportOptions& opt) {
   for (vtkIdType i = 0; i < n_points; ++i) {
     double p[3];
     g->GetPoint(i, p);
-    pts[static_cast<std::size_t>(i)] = {p[0], p[1], p[2]};
+    const double k = opt.length_scale;
+    pts[static_cast<std::size_t>(i)] = {k * p[0], k * p[1], k * p[2]};
   }
   const std::vector<double> values = field_values(f, f.on_cells ? n_cells : n_points);
 
@@ -600,6 +602,9 @@ std::vector<drape::RingSample> ring_from_points(const std::vector<V3>& points,
 }
 
 ImportedRing import_ring(const fs::path& file, const RingImportOptions& opt) {
+  if (!(opt.length_scale > 0) || !std::isfinite(opt.length_scale))
+    throw InputError::out_of_range(file.string(), "--length-scale", opt.length_scale,
+                                   Range::positive());
   const std::string ext = lower(file.extension().string());
   if (ext == ".vtu") return import_vtu(file, opt);
   if (ext == ".csv") {

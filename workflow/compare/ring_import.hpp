@@ -27,9 +27,10 @@ namespace ncfsim::workflow {
 
 struct RingImportOptions {
   drape::RingSpec ring;
-  std::string field;     // shear field / column name; empty: the first of kShearNames found
-  double tolerance = 0;  // m, point-cloud search radius about each ray; 0: 1.5 x the median
-                         // nearest-neighbour spacing of the cloud, at most 10 mm
+  std::string field;        // shear field / column name; empty: the first of kShearNames found
+  double tolerance = 0;     // m, point-cloud search radius about each ray; 0: 1.5 x the median
+                            // nearest-neighbour spacing of the cloud, at most 10 mm
+  double length_scale = 1;  // the files' coordinates times this are metres (1e-3: in mm)
 };
 
 /// Shear field / column names tried in order (case-insensitive) when none is given.
