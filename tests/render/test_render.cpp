@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -398,4 +399,236 @@ TEST(Render, WithoutHexesDropsTheCellsAndTheirValues) {
   const fs::path png = output_dir() / "slab_without_middle.png";
   EXPECT_NO_THROW(render_mesh_png(kept, figure, png));
   EXPECT_TRUE(fs::exists(png));
+}
+
+namespace {
+
+// n_x x n_y shells of unit size in the plane z = z0, x in [x0, x0 + n_x], y in [0, n_y], corners
+// counter-clockwise seen from +z (normal +z), or clockwise (normal -z) with `flipped`. Appended
+// to `mesh` on nodes of their own; returns the index of the first shell.
+std::size_t add_plate(RenderMesh& mesh, int n_x, int n_y, double x0, double z0,
+                      bool flipped = false)
+{
+  const auto first = static_cast<std::int64_t>(mesh.points.size() / 3);
+  auto node = [&](int i, int j) { return first + static_cast<std::int64_t>(j * (n_x + 1) + i); };
+  for (int j = 0; j <= n_y; ++j) {
+    for (int i = 0; i <= n_x; ++i) {
+      mesh.points.insert(mesh.points.end(), {x0 + i, double(j), z0});
+    }
+  }
+  const std::size_t first_shell = mesh.quad4.size() / 4;
+  for (int j = 0; j < n_y; ++j) {
+    for (int i = 0; i < n_x; ++i) {
+      if (flipped) {
+        mesh.quad4.insert(mesh.quad4.end(),
+                          {node(i, j), node(i, j + 1), node(i + 1, j + 1), node(i + 1, j)});
+      } else {
+        mesh.quad4.insert(mesh.quad4.end(),
+                          {node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)});
+      }
+    }
+  }
+  return first_shell;
+}
+
+struct PixelCount {
+  long model = 0, saturated = 0, blue = 0, red = 0, grey = 0;
+  double blue_x = 0.0, red_x = 0.0;
+};
+
+// Pixels of the model viewport (left of the scalar bar, below the title).
+PixelCount count_model_pixels(const Image& img)
+{
+  PixelCount n;
+  for (int y = 0; y < static_cast<int>(0.92 * img.height); ++y) {
+    for (int x = 0; x < static_cast<int>(0.82 * img.width); ++x) {
+      const Rgb c = img.at(x, y);
+      n.model += is_background(c) ? 0 : 1;
+      n.saturated += is_saturated(c) ? 1 : 0;
+      n.grey += near(c, {128, 128, 128}, 12) ? 1 : 0; // the NaN colour (0.5, 0.5, 0.5)
+      if (is_blueish(c)) {
+        ++n.blue;
+        n.blue_x += x;
+      }
+      if (is_redish(c)) {
+        ++n.red;
+        n.red_x += x;
+      }
+    }
+  }
+  return n;
+}
+
+} // namespace
+
+// A shells-only 10 x 10 plate (no hexahedra, no bars) seen from the top, coloured by a cell field
+// linear in x (the shear angle of a macro drape, 0.5 .. 9.5 deg): the plate fills the expected
+// square, the colour range spans the field (the x = 0..1 column blue, the x = 9..10 column red,
+// blue left of red), the plate looks the same seen from below (clockwise corners: two-sided
+// lighting), and a 3-component cell field (magnitude) and a point field colour it too.
+//
+// Expected size as in SlabTopViewPixelStatistics: bounds 10 x 10 x 0, r = |(10, 10, 0)| / 2 =
+// 7.071, the plate spans 828 * 10 / (2 r) = 585.5 px each way: 342,800 px.
+TEST(Render, ShellsOnlyPlateColouredByCellField)
+{
+  for (const bool flipped : {false, true}) {
+    RenderMesh mesh;
+    add_plate(mesh, 10, 10, 0.0, 0.0, flipped);
+    ASSERT_TRUE(mesh.hex8.empty() && mesh.bar2.empty());
+    MeshField shear{"shear_angle_deg", "deg", true, 1, {}};
+    MeshField membrane{"membrane_force", "N/m", true, 3, {}};
+    for (int j = 0; j < 10; ++j) {
+      for (int i = 0; i < 10; ++i) {
+        shear.values.push_back(i + 0.5);
+        membrane.values.insert(membrane.values.end(), {0.0, -(i + 0.5), 0.0}); // |.| = i + 0.5
+      }
+    }
+    MeshField velocity{"velocity", "m/s", false, 3, {}};
+    for (std::size_t p = 0; p < mesh.points.size(); p += 3) {
+      velocity.values.insert(velocity.values.end(), {mesh.points[p], 0.0, 0.0});
+    }
+    mesh.fields = {shear, membrane, velocity};
+
+    for (const char* field : {"shear_angle_deg", "membrane_force", "velocity"}) {
+      const fs::path png = output_dir() / (std::string("plate_") + field +
+                                           (flipped ? "_from_below" : "") + ".png");
+      fs::remove(png);
+      MeshFigure figure;
+      figure.field = field;
+      figure.title = "10 x 10 shells, " + std::string(field);
+      figure.camera = CameraPreset::Top;
+      ASSERT_NO_THROW(render_mesh_png(mesh, figure, png)) << field;
+      const Image img = read_png(png);
+      ASSERT_EQ(img.width, 1200);
+      ASSERT_EQ(img.height, 900);
+      const PixelCount n = count_model_pixels(img);
+      std::cout << field << (flipped ? " (clockwise)" : "") << ": plate pixels " << n.saturated
+                << ", blue " << n.blue << ", red " << n.red << "\n";
+
+      const double expected_plate = std::pow(0.92 * img.height * 10.0 / std::sqrt(200.0), 2);
+      EXPECT_NEAR(n.saturated, expected_plate, 0.02 * expected_plate) << field;
+      // A cell field: one column of cells (10 % of the plate) at each end of the map; a point
+      // field interpolated from 0 to 10 along x: the outer 5 % or so.
+      const double end_share = std::string(field) == "velocity" ? 0.03 : 0.07;
+      EXPECT_GT(n.blue, end_share * expected_plate) << field;
+      EXPECT_GT(n.red, end_share * expected_plate) << field;
+      ASSERT_GT(n.blue, 0);
+      ASSERT_GT(n.red, 0);
+      EXPECT_LT(n.blue_x / n.blue + 0.6 * std::sqrt(expected_plate), n.red_x / n.red) << field;
+    }
+  }
+}
+
+// Hexahedra, bars and shells in one mesh; a cell field's values are the hexes', then the bars',
+// then the shells'. A 4 x 4 x 1 slab (x in [0, 4]) at value 0, a 4 x 4 plate beside it (x in
+// [5, 9], z = 0.5) at value 10, a bar from the slab to the plate at value 5: from the top the
+// slab is blue, the plate red (same size: 16 cells each), blue left of red. A field the shells
+// do not have (NaN there) draws them grey; a point field colours all three kinds.
+TEST(Render, MixedHexBarShellMesh)
+{
+  RenderMesh mesh = slab(4, 4);
+  mesh.fields.clear();
+  add_plate(mesh, 4, 4, 5.0, 0.5);
+  mesh.bar2 = {static_cast<std::int64_t>(4 * 5 + 4 + 25), // slab top corner (4, 4, 1) ..
+               static_cast<std::int64_t>(50)};            // .. first plate node (5, 0, 0.5)
+  ASSERT_EQ(mesh.hex8.size() / 8, 16u);
+  ASSERT_EQ(mesh.quad4.size() / 4, 16u);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  MeshField value{"value", "-", true, 1, {}};
+  MeshField hex_only{"von_mises_stress", "Pa", true, 1, {}};
+  value.values.assign(16, 0.0);
+  value.values.push_back(5.0);
+  value.values.insert(value.values.end(), 16, 10.0);
+  for (int e = 0; e < 16; ++e) {
+    hex_only.values.push_back(e);
+  }
+  hex_only.values.push_back(nan);
+  hex_only.values.insert(hex_only.values.end(), 16, nan);
+  MeshField height{"height", "m", false, 1, {}};
+  for (std::size_t p = 0; p < mesh.points.size(); p += 3) {
+    height.values.push_back(mesh.points[p]); // x
+  }
+  mesh.fields = {value, hex_only, height};
+
+  const fs::path png = output_dir() / "mixed_hex_bar_shell.png";
+  MeshFigure figure;
+  figure.field = "value";
+  figure.camera = CameraPreset::Top;
+  figure.title = "hexahedra 0, bar 5, shells 10";
+  ASSERT_NO_THROW(render_mesh_png(mesh, figure, png));
+  PixelCount n = count_model_pixels(read_png(png));
+  std::cout << "mixed: blue " << n.blue << ", red " << n.red << ", saturated " << n.saturated
+            << "\n";
+  // The bounds are 9 x 4 x 1: r = |(9, 4, 1)| / 2 = 4.95; a 4 x 4 square is 828 * 4 / (2 r) =
+  // 334.5 px wide: 111,900 px each.
+  const double square = std::pow(0.92 * 900 * 4.0 / std::sqrt(98.0), 2);
+  EXPECT_NEAR(n.blue, square, 0.05 * square);
+  EXPECT_NEAR(n.red, square, 0.05 * square);
+  ASSERT_GT(n.blue, 0);
+  ASSERT_GT(n.red, 0);
+  EXPECT_LT(n.blue_x / n.blue + 300.0, n.red_x / n.red);
+
+  figure.field = "von_mises_stress"; // seen from the top: faces lit head-on show exact colours
+  const fs::path png_nan = output_dir() / "mixed_hex_field_on_shells.png";
+  ASSERT_NO_THROW(render_mesh_png(mesh, figure, png_nan));
+  n = count_model_pixels(read_png(png_nan));
+  std::cout << "hex field: grey " << n.grey << ", saturated " << n.saturated << "\n";
+  EXPECT_GT(n.grey, 0.5 * square) << "the shells (NaN) are grey";
+  EXPECT_GT(n.saturated, 0.5 * square) << "the hexahedra are coloured";
+
+  figure.field = "height";
+  const fs::path png_point = output_dir() / "mixed_point_field.png";
+  ASSERT_NO_THROW(render_mesh_png(mesh, figure, png_point));
+  n = count_model_pixels(read_png(png_point));
+  EXPECT_GT(n.blue, 0.1 * square);
+  EXPECT_GT(n.red, 0.1 * square);
+  EXPECT_LT(n.grey, 0.01 * square) << "every kind has the point field";
+
+  // A cell field sized for the hexes and bars alone is refused, naming the count it expects.
+  mesh.fields[0].values.resize(17);
+  figure.field = "value";
+  try {
+    render_mesh_png(mesh, figure, output_dir() / "never.png");
+    FAIL() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("expected 33 cells"), std::string::npos) << e.what();
+  }
+  RenderMesh bad = mesh;
+  bad.quad4.pop_back();
+  EXPECT_THROW(render_mesh_png(bad, figure, output_dir() / "never.png"), std::runtime_error);
+  bad = mesh;
+  bad.quad4[5] = -1;
+  EXPECT_THROW(render_mesh_png(bad, figure, output_dir() / "never.png"), std::runtime_error);
+  EXPECT_FALSE(fs::exists(output_dir() / "never.png"));
+}
+
+// without_cells takes one flag per cell (hexes, bars, shells): dropping a hexahedron, the bar and
+// a shell keeps the others and their values in order; without_hexes keeps every bar and shell.
+TEST(Render, WithoutCellsDropsShellsToo)
+{
+  RenderMesh mesh = slab(2, 1);
+  mesh.fields.clear();
+  add_plate(mesh, 3, 1, 3.0, 0.0);
+  mesh.bar2 = {0, 1};
+  MeshField f{"f", "-", true, 2, {}};
+  for (int c = 0; c < 6; ++c) { // 2 hexes, 1 bar, 3 shells
+    f.values.insert(f.values.end(), {double(c), -double(c)});
+  }
+  mesh.fields = {f};
+  const RenderMesh kept = without_cells(mesh, {1, 0, 1, 0, 1, 0});
+  EXPECT_EQ(kept.hex8, std::vector<std::int64_t>(mesh.hex8.begin() + 8, mesh.hex8.end()));
+  EXPECT_TRUE(kept.bar2.empty());
+  ASSERT_EQ(kept.quad4.size(), 8u);
+  EXPECT_EQ(std::vector<std::int64_t>(kept.quad4.begin(), kept.quad4.begin() + 4),
+            std::vector<std::int64_t>(mesh.quad4.begin(), mesh.quad4.begin() + 4));
+  EXPECT_EQ(std::vector<std::int64_t>(kept.quad4.begin() + 4, kept.quad4.end()),
+            std::vector<std::int64_t>(mesh.quad4.begin() + 8, mesh.quad4.end()));
+  EXPECT_EQ(kept.fields[0].values, (std::vector<double>{1, -1, 3, -3, 5, -5}));
+  EXPECT_THROW(without_cells(mesh, {0, 0, 0}), std::invalid_argument);
+
+  const RenderMesh no_hex = without_hexes(mesh, {1, 1});
+  EXPECT_TRUE(no_hex.hex8.empty());
+  EXPECT_EQ(no_hex.bar2, mesh.bar2);
+  EXPECT_EQ(no_hex.quad4, mesh.quad4);
+  EXPECT_EQ(no_hex.fields[0].values, (std::vector<double>{2, -2, 3, -3, 4, -4, 5, -5}));
 }

@@ -45,6 +45,8 @@ std::string unit_of(const std::string& field) {
   if (field == "displacement" || field == "displacement_magnitude") return "m";
   if (field == "velocity") return "m/s";
   if (field == "axial_force") return "N";
+  if (field == "membrane_force") return "N/m";    // shells: force per unit length of the section
+  if (field == "bending_moment") return "N m/m";  // shells: moment per unit length
   if (field == "shear_angle_deg" || field == "wrinkle_angle_deg") return "deg";
   if (field == "interply_slip_m") return "m";
   return "-";
@@ -203,6 +205,7 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
       render::RenderMesh rm;
       rm.hex8 = m.hex8;
       rm.bar2 = m.bar2;
+      rm.quad4 = m.quad4;
       for (const auto& f : frame.fields) {
         if (f.name == "displacement") {
           render::MeshField mag{"displacement_magnitude", "m", false, 1, {}};
@@ -214,15 +217,15 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
         }
         rm.fields.push_back({f.name, unit_of(f.name), f.on_cells, f.n_components, f.values});
       }
-      // Eroded hexahedra are not drawn: nothing holds their lone nodes, which fly off.
-      const std::size_t n_hex = m.hex8.size() / 8;
-      std::vector<char> eroded(n_hex, 0);
+      // Eroded elements are not drawn: nothing holds their lone nodes, which fly off. One flag
+      // per cell (hexes, bars, shells, as the field); NaN (a kind without the field) is kept.
+      std::vector<char> eroded(m.n_cells(), 0);
       for (const auto& f : frame.fields)
         if (f.name == "eroded" && f.on_cells && f.n_components == 1)
-          for (std::size_t e = 0; e < n_hex && e < f.values.size(); ++e)
-            eroded[e] = f.values[e] != 0;
+          for (std::size_t c = 0; c < eroded.size() && c < f.values.size(); ++c)
+            eroded[c] = f.values[c] > 0.5;
       if (std::find(eroded.begin(), eroded.end(), 1) != eroded.end())
-        rm = render::without_hexes(rm, eroded);
+        rm = render::without_cells(rm, eroded);
       for (const auto& p : spec.at("pictures")) {
         const std::string name = p.at("name");
         try {
@@ -255,8 +258,13 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
             for (std::size_t e = 0; e < m.hex_part.size(); ++e)
               if (m.hex_part[e] == part && !eroded[e])
                 for (int I = 0; I < 8; ++I) grow(m.hex8[8 * e + static_cast<std::size_t>(I)]);
+            const std::size_t n_hex = m.n_hex(), n_bar = m.n_bar();
             for (std::size_t e = 0; e < m.bar_part.size(); ++e)
-              if (m.bar_part[e] == part) grow(m.bar2[2 * e]), grow(m.bar2[2 * e + 1]);
+              if (m.bar_part[e] == part && !eroded[n_hex + e])
+                grow(m.bar2[2 * e]), grow(m.bar2[2 * e + 1]);
+            for (std::size_t e = 0; e < m.quad_part.size(); ++e)
+              if (m.quad_part[e] == part && !eroded[n_hex + n_bar + e])
+                for (std::size_t I = 0; I < 4; ++I) grow(m.quad4[4 * e + I]);
             if (b[0] <= b[1]) fig.focus_bounds = b;
           }
           fig.title = p.at("title").get<std::string>() + " (t = " + fmt_time(frame.time) + " s" +

@@ -285,7 +285,7 @@ int scaled_font(int height, double fraction, int minimum) {
 // Mesh figures
 
 struct Scalars {
-  std::vector<double> values;  // one per point (on_cells = false) or per cell, hexes then bars
+  std::vector<double> values;  // one per point (on_cells = false) or per cell: hexes, bars, shells
   bool on_cells = false;
   std::string bar_title;  // "name [unit]", "name (x) [unit]", "name (magnitude) [unit]"
 };
@@ -303,8 +303,12 @@ void validate_mesh(const RenderMesh& mesh, const std::string& where) {
     fail(where,
          "bar2 must hold 2 node ids per bar, got " + std::to_string(mesh.bar2.size()) + " ids");
   }
-  if (mesh.hex8.empty() && mesh.bar2.empty()) {
-    fail(where, "the mesh has no hexahedra and no bars");
+  if (mesh.quad4.size() % 4 != 0) {
+    fail(where,
+         "quad4 must hold 4 node ids per shell, got " + std::to_string(mesh.quad4.size()) + " ids");
+  }
+  if (mesh.hex8.empty() && mesh.bar2.empty() && mesh.quad4.empty()) {
+    fail(where, "the mesh has no hexahedra, no bars and no shells");
   }
   const auto n_points = static_cast<std::int64_t>(mesh.points.size() / 3);
   auto check_ids = [&](const std::vector<std::int64_t>& ids, const char* what) {
@@ -317,6 +321,7 @@ void validate_mesh(const RenderMesh& mesh, const std::string& where) {
   };
   check_ids(mesh.hex8, "hex8");
   check_ids(mesh.bar2, "bar2");
+  check_ids(mesh.quad4, "quad4");
   for (double c : mesh.points) {
     if (!std::isfinite(c)) {
       fail(where, "a node coordinate is not finite");
@@ -356,7 +361,8 @@ Scalars select_scalars(const RenderMesh& mesh, const MeshFigure& figure, const s
                     "' out of range [-1, " + std::to_string(n_comp - 1) + "]");
   }
   const std::size_t n_entities =
-      field->on_cells ? mesh.hex8.size() / 8 + mesh.bar2.size() / 2 : mesh.points.size() / 3;
+      field->on_cells ? mesh.hex8.size() / 8 + mesh.bar2.size() / 2 + mesh.quad4.size() / 4
+                      : mesh.points.size() / 3;
   if (field->values.size() != n_entities * static_cast<std::size_t>(n_comp)) {
     fail(where, "field '" + field->name + "' has " + std::to_string(field->values.size()) +
                     " values, expected " + std::to_string(n_entities) + " " +
@@ -542,32 +548,52 @@ BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8) {
 
 }  // namespace
 
-RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop) {
-  const std::size_t n_hex = mesh.hex8.size() / 8;
-  if (drop.size() != n_hex)
-    throw std::invalid_argument("without_hexes: " + std::to_string(drop.size()) + " flags for " +
-                                std::to_string(n_hex) + " hexahedra");
+RenderMesh without_cells(const RenderMesh& mesh, const std::vector<char>& drop) {
+  const std::size_t n_hex = mesh.hex8.size() / 8, n_bar = mesh.bar2.size() / 2,
+                    n_quad = mesh.quad4.size() / 4, n_cells = n_hex + n_bar + n_quad;
+  if (drop.size() != n_cells)
+    throw std::invalid_argument("without_cells: " + std::to_string(drop.size()) + " flags for " +
+                                std::to_string(n_cells) + " cells (" + std::to_string(n_hex) +
+                                " hexahedra, " + std::to_string(n_bar) + " bars, " +
+                                std::to_string(n_quad) + " shells)");
   RenderMesh out;
   out.points = mesh.points;
-  out.bar2 = mesh.bar2;
-  for (std::size_t e = 0; e < n_hex; ++e)
-    if (!drop[e])
-      out.hex8.insert(out.hex8.end(), mesh.hex8.begin() + 8 * e, mesh.hex8.begin() + 8 * e + 8);
+  // Copies the kept cells of one kind, whose flags are drop[first .. first + count).
+  auto keep = [&](const std::vector<std::int64_t>& from, std::size_t n_nodes, std::size_t first,
+                  std::size_t count, std::vector<std::int64_t>& to) {
+    for (std::size_t e = 0; e < count; ++e)
+      if (!drop[first + e])
+        to.insert(to.end(), from.begin() + static_cast<std::ptrdiff_t>(n_nodes * e),
+                  from.begin() + static_cast<std::ptrdiff_t>(n_nodes * (e + 1)));
+  };
+  keep(mesh.hex8, 8, 0, n_hex, out.hex8);
+  keep(mesh.bar2, 2, n_hex, n_bar, out.bar2);
+  keep(mesh.quad4, 4, n_hex + n_bar, n_quad, out.quad4);
   for (const auto& f : mesh.fields) {
     if (!f.on_cells) {
       out.fields.push_back(f);
       continue;
     }
     MeshField g{f.name, f.unit, true, f.n_components, {}};
-    const auto nc = static_cast<std::size_t>(f.n_components);
-    for (std::size_t e = 0; e < n_hex && nc * (e + 1) <= f.values.size(); ++e)
-      if (!drop[e])
-        g.values.insert(g.values.end(), f.values.begin() + nc * e, f.values.begin() + nc * (e + 1));
-    if (f.values.size() > nc * n_hex)  // the bars' values
-      g.values.insert(g.values.end(), f.values.begin() + nc * n_hex, f.values.end());
+    const auto nc = static_cast<std::size_t>(std::max(f.n_components, 0));
+    // A field of the wrong size is kept as far as it goes (render_mesh_png names the mismatch).
+    for (std::size_t c = 0; c < n_cells && nc * (c + 1) <= f.values.size(); ++c)
+      if (!drop[c])
+        g.values.insert(g.values.end(), f.values.begin() + static_cast<std::ptrdiff_t>(nc * c),
+                        f.values.begin() + static_cast<std::ptrdiff_t>(nc * (c + 1)));
     out.fields.push_back(std::move(g));
   }
   return out;
+}
+
+RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop) {
+  const std::size_t n_hex = mesh.hex8.size() / 8;
+  if (drop.size() != n_hex)
+    throw std::invalid_argument("without_hexes: " + std::to_string(drop.size()) + " flags for " +
+                                std::to_string(n_hex) + " hexahedra");
+  std::vector<char> cells(drop);
+  cells.resize(n_hex + mesh.bar2.size() / 2 + mesh.quad4.size() / 4, 0);
+  return without_cells(mesh, cells);
 }
 
 void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
@@ -588,10 +614,11 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
   std::lock_guard lock(render_mutex());
   OffscreenWindow ow(figure.width, figure.height, where);
 
-  // Geometry: the same points for the solid part and the bars.
+  // Geometry: the same points for the solid part, the bars and the shells.
   const std::size_t n_points = mesh.points.size() / 3;
   const std::size_t n_hex = mesh.hex8.size() / 8;
   const std::size_t n_bar = mesh.bar2.size() / 2;
+  const std::size_t n_quad = mesh.quad4.size() / 4;
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(static_cast<vtkIdType>(n_points));
@@ -687,6 +714,42 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
     scene->AddActor(solid_actor);
   }
 
+  vtkNew<vtkPolyData> shells;  // the shells' mid-surfaces
+  vtkNew<vtkPolyDataMapper> shell_mapper;
+  vtkNew<vtkActor> shell_actor;
+  if (n_quad > 0) {
+    vtkNew<vtkCellArray> polys;
+    polys->AllocateExact(static_cast<vtkIdType>(n_quad), static_cast<vtkIdType>(4 * n_quad));
+    for (std::size_t q = 0; q < n_quad; ++q) {
+      vtkIdType ids[4];
+      for (std::size_t k = 0; k < 4; ++k) {
+        ids[k] = static_cast<vtkIdType>(mesh.quad4[4 * q + k]);
+      }
+      polys->InsertNextCell(4, ids);
+    }
+    shells->SetPoints(points);
+    shells->SetPolys(polys);
+    if (point_scalars) {
+      shells->GetPointData()->SetScalars(point_scalars);
+    } else if (coloured) {
+      shells->GetCellData()->SetScalars(
+          make_array(figure.field, scalars.values.data() + n_hex + n_bar, n_quad));
+    }
+    shell_mapper->SetInputData(shells);
+    configure_mapper(shell_mapper);
+    shell_actor->SetMapper(shell_mapper);
+    vtkProperty* p = shell_actor->GetProperty();
+    // As the hexahedra's faces; the renderer's two-sided lighting (VTK's default) lights a shell
+    // seen from below as one seen from above.
+    p->SetAmbient(0.25);
+    p->SetDiffuse(0.75);
+    p->SetSpecular(0.0);
+    if (!coloured) {
+      p->SetColor(0.78, 0.80, 0.84);
+    }
+    scene->AddActor(shell_actor);
+  }
+
   vtkNew<vtkPolyData> bars;
   vtkNew<vtkPolyDataMapper> bar_mapper;
   vtkNew<vtkActor> bar_actor;
@@ -708,7 +771,7 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
     }
     bar_mapper->SetInputData(bars);
     configure_mapper(bar_mapper);
-    // Lines in front of coincident hex faces (bars embedded in a solid's surface stay visible).
+    // Lines in front of coincident hex faces and shells (bars on a surface stay visible).
     bar_mapper->SetResolveCoincidentTopologyToPolygonOffset();
     bar_actor->SetMapper(bar_mapper);
     vtkProperty* p = bar_actor->GetProperty();

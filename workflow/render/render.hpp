@@ -20,7 +20,9 @@
 namespace ncfsim::render {
 
 // One field on a RenderMesh. values: [n_components * n_entities], component fastest, where the
-// entities are the points (on_cells = false) or the cells, hexes first then bars (on_cells = true).
+// entities are the points (on_cells = false) or the cells, hexes first, then bars, then shells
+// (on_cells = true; the order of the results files). NaN values are drawn grey (e.g. a field of
+// one element kind on the others).
 struct MeshField {
   std::string name;
   std::string unit;
@@ -30,10 +32,11 @@ struct MeshField {
 };
 
 struct RenderMesh {
-  std::vector<double> points;      // xyz interleaved, [3*n_points]
-  std::vector<std::int64_t> hex8;  // 8 node ids per hexahedron (VTK ordering)
-  std::vector<std::int64_t> bar2;  // 2 node ids per bar
-  std::vector<MeshField> fields;   // cell fields have values for hexes first, then bars
+  std::vector<double> points;       // xyz interleaved, [3*n_points]
+  std::vector<std::int64_t> hex8;   // 8 node ids per hexahedron (VTK ordering)
+  std::vector<std::int64_t> bar2;   // 2 node ids per bar
+  std::vector<std::int64_t> quad4;  // 4 node ids per shell, counter-clockwise (VTK_QUAD ordering)
+  std::vector<MeshField> fields;    // cell fields: values for hexes first, then bars, then shells
 };
 
 // Top: looking down -z, +y up. Front: looking along +y, +z up. Iso: from the (+x, -y, +z) octant,
@@ -56,14 +59,18 @@ struct MeshFigure {
   std::vector<std::string> categories;
 };
 
-// The mesh without the hexahedra marked in `drop` (one flag per hexahedron, e.g. eroded ones, whose
-// nodes may have flown off once nothing held them): their cell-field values go with them; the
-// points, the bars and the point fields stay. Throws std::invalid_argument if `drop` does not hold
-// one flag per hexahedron.
+// The mesh without the cells marked in `drop` (one flag per cell: hexes, then bars, then shells;
+// e.g. eroded elements, whose nodes may have flown off once nothing held them): their cell-field
+// values go with them; the points and the point fields stay. Throws std::invalid_argument if
+// `drop` does not hold one flag per cell.
+RenderMesh without_cells(const RenderMesh& mesh, const std::vector<char>& drop);
+
+// The same with one flag per hexahedron: the bars and the shells all stay.
 RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop);
 
-// Surface of the hexahedra plus the bars as lines, coloured by the field (blue = low, red = high),
-// a scalar bar titled "name [unit]", the figure title, white background.
+// Surface of the hexahedra, the shells as quadrilaterals (both sides lit) and the bars as lines,
+// coloured by the field (blue = low, red = high; NaN grey), a scalar bar titled "name [unit]", the
+// figure title, white background. A mesh of any one kind alone renders.
 void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
                      const std::filesystem::path& png);
 
