@@ -34,6 +34,9 @@ struct BendingLengthProbe {
 /// summary.json max_shear_deg_q1..q4, ring_shear.csv.
 struct RingShearProbe {
   int part_a = -1, part_b = -1;
+  // A macro (shell) drape: the one shell part whose shear_angle_deg is read instead of the two
+  // plies' inter-ply angle (-1: meso); keys macro_max_shear_deg_q1..q4, column macro_shear_deg.
+  int shell_part = -1;
   RingSpec ring;
   // The kinematic (pin-jointed net) drape of a kinematic_drape case on the same ring, computed
   // once when the case is read (empty: none): the ring CSV's kinematic_shear_deg column and the

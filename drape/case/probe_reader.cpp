@@ -17,7 +17,8 @@ namespace {
 // `parts = [ply_a, ply_b]`: the two plies a probe compares, as part indices.
 std::pair<int, int> two_plies(const TableReader& t, const fem::Mesh& mesh) {
   const auto parts = t.strings("parts");
-  if (parts.size() != 2) t.fail("parts", "must name exactly 2 parts (the two plies)");
+  if (parts.size() != 2)
+    t.fail("parts", "must name exactly 2 parts (the two plies), or one shell part (a macro drape)");
   const int a = mesh.find_part(parts[0]), b = mesh.find_part(parts[1]);
   if (a < 0 || b < 0) t.fail("parts", "no part named '" + parts[a < 0 ? 0 : 1] + "'");
   return {a, b};
@@ -59,7 +60,19 @@ std::vector<RingShearProbe> read_ring_shear_probes(const fem::CaseReadContext& c
            "give at most one [[output.ring_shear]] (its keys are max_shear_deg_q1..q4)");
   for (const auto& t : tables) {
     RingShearProbe rp;
-    std::tie(rp.part_a, rp.part_b) = two_plies(t, mesh);
+    const auto parts = t.strings("parts");
+    const int p0 = parts.size() == 1 ? mesh.find_part(parts[0]) : -1;
+    bool shells = false;
+    if (p0 >= 0)
+      for (std::size_t e = 0; e < mesh.elements(fem::ElementKind::Quad4).size(); ++e)
+        if (mesh.elements(fem::ElementKind::Quad4).part[e] == p0) {
+          shells = true;
+          break;
+        }
+    if (shells)
+      rp.shell_part = p0;
+    else
+      std::tie(rp.part_a, rp.part_b) = two_plies(t, mesh);
     read_ring(t, rp.ring);
     if (t.has("kinematic_case")) {
       std::filesystem::path kf = t.string("kinematic_case");

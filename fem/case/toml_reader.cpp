@@ -153,6 +153,65 @@ toml::table resolve_base(const std::filesystem::path& file, toml::table root, in
   return out;
 }
 
+// Merges `inc` (from file `from`) into `into`: keys absent from `into` are added, tables merge
+// key by key, arrays of tables are the included entries first, then the case's own; any other
+// key given in both is an error (a case does not silently change what it includes).
+void merge_included(toml::table& into, const toml::table& inc, const std::string& case_file,
+                    const std::string& from, const std::string& path) {
+  for (const auto& [k, v] : inc) {
+    const std::string key = path.empty() ? std::string(k.str()) : path + "." + std::string(k.str());
+    toml::node* mine = into.get(k.str());
+    if (!mine) {
+      into.insert(k.str(), v);
+    } else if (mine->is_table() && v.is_table()) {
+      merge_included(*mine->as_table(), *v.as_table(), case_file, from, key);
+    } else if (mine->is_array_of_tables() && v.is_array_of_tables()) {
+      toml::array merged = *v.as_array();
+      for (const auto& e : *mine->as_array()) merged.push_back(e);
+      into.insert_or_assign(k.str(), std::move(merged));
+    } else {
+      throw InputError(case_file, key,
+                       "given both here and in the included file " + from +
+                           " (change it there, or leave it out of one of them)");
+    }
+  }
+}
+
+// `include = ["tools.toml", ...]` at the top of a case: the keys of those files (paths relative
+// to the case), merged into the case (merge_included). Shared descriptions (the tools of a
+// forming process used by its meso and macro cases) live in one file.
+toml::table resolve_includes(const std::filesystem::path& file, toml::table root, int depth) {
+  const std::string fname = file.string();
+  const toml::node* n = root.get("include");
+  if (!n) return root;
+  const toml::array* a = n->as_array();
+  std::vector<std::string> files;
+  if (const auto one = n->value<std::string>()) files.push_back(*one);
+  else if (a)
+    for (const auto& e : *a) {
+      const auto f = e.value<std::string>();
+      if (!f || f->empty()) throw InputError(fname, "include", "must be an array of file paths");
+      files.push_back(*f);
+    }
+  else
+    throw InputError(fname, "include", "must be a file path or an array of file paths");
+  if (depth >= 4) throw InputError(fname, "include", "includes nest more than 4 deep (a cycle?)");
+  root.erase("include");
+  for (const auto& f : files) {
+    std::filesystem::path inc = f;
+    if (inc.is_relative()) inc = file.parent_path() / inc;
+    if (!std::filesystem::is_regular_file(inc))
+      throw InputError(fname, "include", "no such file: " + inc.string());
+    toml::table t = resolve_includes(inc, parse_case_file(inc), depth + 1);
+    if (t.contains("case"))
+      throw InputError(inc.string(), "case",
+                       "an included file holds shared sections only, not [case] (included by " +
+                           fname + ")");
+    merge_included(root, t, fname, inc.string(), "");
+  }
+  return root;
+}
+
 }  // namespace
 
 CaseDocument CaseDocument::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
@@ -164,7 +223,7 @@ CaseDocument CaseDocument::load_resolved(const std::filesystem::path& file,
   CaseDocument doc;
   doc.file_ = file;
   const std::string fname = file.string();
-  doc.root_ = resolve_base(file, parse_case_file(file), depth);
+  doc.root_ = resolve_base(file, resolve_includes(file, parse_case_file(file), 0), depth);
   for (const std::string& ov : overrides) {
     const auto eq = ov.find('=');
     if (eq == std::string::npos || eq == 0)

@@ -117,6 +117,19 @@ void check_starts_clear(const TableReader& t, const RigidTool& tool, const Mesh&
   t.fail("point", os.str());
 }
 
+// The default contact nodes of a tool: every node of a hexahedron or a shell (not the nodes only
+// bars hold: a stitch yarn rides on its tows).
+std::vector<std::int32_t> solid_and_shell_nodes(const Mesh& mesh) {
+  std::vector<char> used(mesh.n_nodes(), 0);
+  for (const auto& set : mesh.sets)
+    if (set.kind == ElementKind::Hex8 || set.kind == ElementKind::Quad4)
+      for (auto v : set.conn) used[static_cast<std::size_t>(v)] = 1;
+  std::vector<std::int32_t> out;
+  for (std::size_t i = 0; i < used.size(); ++i)
+    if (used[i]) out.push_back(static_cast<std::int32_t>(i));
+  return out;
+}
+
 void read_tool(CaseReadContext& ctx, const TableReader& t) {
   RigidTool tool;
   tool.name = t.string("name");
@@ -125,9 +138,16 @@ void read_tool(CaseReadContext& ctx, const TableReader& t) {
   tool.friction = t.number("friction", 0.0, Range::non_negative());
   tool.penalty_scale = t.number("penalty_scale", 0.1, Range::open_closed(0, 1.0));
   tool.damping = t.number("damping", 0.1, Range::closed(0, 1.0));
-  tool.thickness = t.number("thickness", 0.0, Range::non_negative());
+  // Shells touch a tool with their faces: by default the contact offset is half the thickest
+  // shell's thickness (0 without shells: solids touch with their surface nodes).
+  double half_shell = 0;
+  for (const auto& pp : ctx.model.parts) half_shell = std::max(half_shell, 0.5 * pp.shell_thickness);
+  tool.thickness = t.number("thickness", half_shell, Range::non_negative());
   tool.search_margin = t.number("search_margin", 0.0, Range::non_negative());
-  tool.contact_nodes = select_nodes(ctx, t, "contact_nodes");
+  tool.contact_nodes = t.has("contact_nodes") ? select_nodes(ctx, t, "contact_nodes")
+                                              : solid_and_shell_nodes(ctx.model.mesh);
+  if (tool.contact_nodes.empty())
+    t.fail("contact_nodes", "missing, and the model has no solid or shell element to touch");
   check_starts_clear(t, tool, ctx.model.mesh);
   if (tool.motion.kind == ToolMotion::Kind::Force && t.has("pressure")) {
     if (tool.surface.shape != ToolShape::Plane && tool.surface.shape != ToolShape::PlaneWithHole)

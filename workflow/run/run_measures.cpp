@@ -216,7 +216,10 @@ MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s
   for (const auto& bp : ec.bending)
     m.push_back(std::make_unique<drape::BendingLengthMeasure>(bp, s));
   for (const auto& rp : ec.ring_probes)
-    m.push_back(std::make_unique<drape::RingShearMeasure>(rp, s));
+    if (rp.shell_part >= 0)
+      m.push_back(std::make_unique<drape::ShellRingShearMeasure>(rp, s));
+    else
+      m.push_back(std::make_unique<drape::RingShearMeasure>(rp, s));
   if (auto curve = make_bias_extension_curve(ec)) m.push_back(std::move(curve));
   if (ec.crush.enabled)
     m.push_back(std::make_unique<impact::CrushMeasure>(s, ec.crush.punch, ec.crush.cfc));
