@@ -177,7 +177,9 @@ ImportedRing import_csv(const fs::path& file, const RingImportOptions& opt) {
     };
     const double k = opt.length_scale;
     pts.push_back({k * num(cx, false), k * num(cy, false), k * num(cz, false)});
-    val.push_back(num(cs, true));  // NaN: no value at that point (skipped)
+    // NaN: no value at that point (skipped); a signed shear (a macro code's, or ncfsim's own
+    // shell field) counts by its magnitude, as the meso and kinematic rings measure it.
+    val.push_back(std::abs(num(cs, true)));
   }
   if (pts.empty()) throw InputError(file.string(), "", "holds a header but no rows");
   if (std::none_of(val.begin(), val.end(), [](double v) { return std::isfinite(v); }))
@@ -306,7 +308,8 @@ std::vector<double> field_values(const VtuField& f, vtkIdType n) {
   std::vector<double> v(static_cast<std::size_t>(n), kNaN);
   for (vtkIdType i = 0; i < n; ++i) {
     if (f.shear) {
-      v[static_cast<std::size_t>(i)] = f.shear->GetComponent(i, 0);
+      // by its magnitude, like the CSV's
+      v[static_cast<std::size_t>(i)] = std::abs(f.shear->GetComponent(i, 0));
     } else {
       double a[3], b[3];
       f.fibre_a->GetTuple(i, a);
