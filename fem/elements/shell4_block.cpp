@@ -250,6 +250,7 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
   const double E = b.section.youngs_modulus;
   const double Q11 = law ? 0.0 : E / (1 - nu * nu), Q12 = nu * Q11, G2 = E / (1 + nu);
   double w_int = 0, w_hg = 0;
+  const double slowness = std::sqrt(b.areal_density / b.membrane_stiffness);  // 1 / wave speed
 
   ShellFrame fr[kChunk];
   double Fc[4][kChunk], Nc[3][kChunk];
@@ -448,15 +449,16 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
           mi[k] -= ml[0] * f.e[0][k] + ml[1] * f.e[1][k] + ml[2] * f.e[2][k];
         }
       }
-      // Stable step at the current shape.
-      double lmin = 1e300, lmax = 0;
+      // Stable step at the current shape (squared lengths: two roots per element).
+      double l2min = 1e300, l2max = 0;
       for (int I = 0; I < 4; ++I) {
         const int Jn = (I + 1) % 4;
-        const double l = len2(f.xl[Jn] - f.xl[I], f.yl[Jn] - f.yl[I]);
-        lmin = std::min(lmin, l), lmax = std::max(lmax, l);
+        const double dx = f.xl[Jn] - f.xl[I], dy = f.yl[Jn] - f.yl[I];
+        const double l2 = dx * dx + dy * dy;
+        l2min = std::min(l2min, l2), l2max = std::max(l2max, l2);
       }
-      const double L = std::min(lmin, A / lmax);
-      const double dte = L * std::sqrt(b.areal_density * b.mass_scale[e] / b.membrane_stiffness);
+      const double L2 = std::min(l2min, A * A / l2max);
+      const double dte = std::sqrt(L2 * b.mass_scale[e]) * slowness;
       if (dte < step.dt) step = {dte, b.user_id[e], ElementKind::Quad4};
     }
   }

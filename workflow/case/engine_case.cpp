@@ -138,6 +138,8 @@ PictureSpec read_picture(const TableReader& t, const fem::Mesh& mesh) {
                       "axial_force",
                       "axial_strain",
                       "shear_angle_deg",
+                      "membrane_force",
+                      "bending_moment",
                       "interply_slip_m",
                       "wrinkle_angle_deg",
                       "vf",
