@@ -14,6 +14,7 @@
 #include "fem/errors.hpp"
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
+#include "workflow/calibrate/calibrate_macro.hpp"
 #include "workflow/calibrate/calibrate_stitch.hpp"
 #include "workflow/calibrate/calibrate_tow_bending.hpp"
 #include "workflow/case/engine_case.hpp"
@@ -175,6 +176,48 @@ int main(int argc, char** argv) {
   cal_bend->add_option("-o,--output", tb.out_dir,
                        "Output folder (default tow_bending_calibration)");
 
+  wf::MacroCalibrationOptions mc;
+  std::vector<double> mc_angles;
+  auto* cal_macro = calibrate->add_subcommand(
+      "macro",
+      "Macro fabric membrane law ([[membrane_law]] type fabric) from the meso picture-frame "
+      "runs: normalised shear force vs shear angle per sign, monotone, as a TOML block");
+  cal_macro->add_option("--positive", mc.positive, "Meso picture-frame run folder, positive shear")
+      ->required();
+  cal_macro->add_option("--negative", mc.negative, "Meso picture-frame run folder, negative shear")
+      ->required();
+  cal_macro->add_option(
+      "--unstitched", mc.unstitched,
+      "Unstitched meso frame run folder: a second, symmetric law <name>_unstitched");
+  cal_macro->add_option(
+      "--bias-positive", mc.bias_positive,
+      "Meso bias-extension run folder, positive (a check, in the file's comments)");
+  cal_macro->add_option("--bias-negative", mc.bias_negative,
+                        "Meso bias-extension run folder, negative (a check)");
+  cal_macro->add_flag("--symmetric", mc.symmetric, "One curve: the mean of the two signs");
+  cal_macro->add_option("--frame", mc.frame, "Picture-frame name in the runs (default frame)");
+  cal_macro->add_option("--name", mc.name, "[[membrane_law]] name (default ncf_macro)");
+  cal_macro->add_option("--step", mc.step_deg, "Angle step of the curve, deg (default 2.5)");
+  cal_macro->add_option("--max-angle", mc.max_angle_deg,
+                        "Last angle of the curve, deg (default: as far as the runs reach)");
+  cal_macro->add_option("--areal-density", mc.areal_density, "kg/m^2 (default 0.482)");
+  cal_macro->add_option("--fibre-angles", mc_angles, "From the wale, deg (default 45,-45)")
+      ->expected(2)
+      ->delimiter(',');
+  cal_macro->add_option("--fibre-tension-stiffness", mc.fibre_tension_stiffness,
+                        "N/m per family (default 2e5)");
+  cal_macro->add_option("--fibre-compression-ratio", mc.fibre_compression_ratio,
+                        "Compression / tension stiffness (default 1e-3)");
+  cal_macro->add_option("--bending-stiffness", mc.bending_stiffness, "N m (default 1e-4)");
+  cal_macro->add_option("--coupon-length", mc.coupon_length,
+                        "Bias-extension check: free length H, m (default 0.25)");
+  cal_macro->add_option("--coupon-width", mc.coupon_width,
+                        "Bias-extension check: width W, m (default 0.10)");
+  cal_macro->add_option("--curves-csv", mc.curves_csv,
+                        "Also write the meso curves on the grid (fitted and clipped) to this CSV");
+  cal_macro->add_option("-o,--output", mc.output,
+                        "The TOML file written (default macro_membrane_law.toml)");
+
   wf::CompareOptions cmp;
   std::vector<double> ring_centre, ring_axis, ring_zero;
   auto* compare = app.add_subcommand(
@@ -255,6 +298,15 @@ int main(int argc, char** argv) {
       std::printf(
           "%s: stitch_law.csv, stitch_law.toml, figures/stitch_law.png, figures/stitch_fit.png\n",
           sc.out_dir.c_str());
+      return wf::kSuccess;
+    }
+    if (*cal_macro) {
+      if (!mc_angles.empty()) mc.fibre_angles_deg = {mc_angles[0], mc_angles[1]};
+      const auto r = wf::calibrate_macro(mc);
+      for (const auto& n : r.notes) std::printf("%s\n", n.c_str());
+      std::printf("%s: [[membrane_law]] \"%s\" (%zu + %zu curve points)\n", mc.output.c_str(),
+                  mc.name.c_str(), r.positive.curve.angle_deg.size(),
+                  mc.symmetric ? std::size_t{0} : r.negative.curve.angle_deg.size());
       return wf::kSuccess;
     }
     if (*cal_bend) {
