@@ -1,9 +1,15 @@
 // The macro fabric membrane law (drape/fabric_membrane.hpp).
+// GCC 12 reports false (maybe-)uninitialized warnings inside its AVX-512 intrinsics when it
+// inlines std::experimental::simd (as in fem/elements/hex8_block.cpp).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 #include "drape/fabric_membrane.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include "fem/elements/simd_batch.hpp"
 
 namespace ncfsim::drape {
 
@@ -60,36 +66,47 @@ double FabricMembraneLaw::shear_force(double g) const {
 }
 
 void FabricMembraneLaw::update(const fem::MembraneBatch& b) const {
+  // Elements in SIMD lanes; the shear angle and the table lookup per lane.
+  using fem::batch::VD;
+  using fem::batch::W;
+  namespace stdx = std::experimental;
   const std::size_t st = b.stride;
   const double K = c_.fibre_tension_stiffness, Kc = K * c_.fibre_compression_ratio;
   double cf[2], sf[2];
   for (int k = 0; k < 2; ++k)
     cf[k] = std::cos(c_.fibre_angles[static_cast<std::size_t>(k)]),
     sf[k] = std::sin(c_.fibre_angles[static_cast<std::size_t>(k)]);
-  for (std::size_t e = 0; e < b.n; ++e) {
-    const double F11 = b.F[e], F12 = b.F[st + e], F21 = b.F[2 * st + e], F22 = b.F[3 * st + e];
-    const double m1x = b.axes[e], m1y = b.axes[st + e], m2x = b.axes[2 * st + e],
-                 m2y = b.axes[3 * st + e];
-    const double J = F11 * F22 - F12 * F21;
-    double a[2][2], N[3] = {0, 0, 0};
+  for (std::size_t e0 = 0; e0 < b.n; e0 += W) {
+    const int cnt = static_cast<int>(std::min<std::size_t>(W, b.n - e0));
+    auto ld = [&](const double* p, std::size_t row) {
+      return fem::batch::load(p + row * st + e0, cnt);
+    };
+    const VD F11 = ld(b.F, 0), F12 = ld(b.F, 1), F21 = ld(b.F, 2), F22 = ld(b.F, 3);
+    const VD m1x = ld(b.axes, 0), m1y = ld(b.axes, 1), m2x = ld(b.axes, 2), m2y = ld(b.axes, 3);
+    const VD J = F11 * F22 - F12 * F21;
+    VD a[2][2], N0 = 0.0, N1 = 0.0, N2 = 0.0;
     for (int k = 0; k < 2; ++k) {
-      const double Ax = cf[k] * m1x + sf[k] * m2x, Ay = cf[k] * m1y + sf[k] * m2y;
-      const double x = F11 * Ax + F12 * Ay, y = F21 * Ax + F22 * Ay;
-      const double lam = std::sqrt(x * x + y * y);
-      a[k][0] = x / lam, a[k][1] = y / lam;
-      const double eps = lam - 1;
-      const double T = (eps > 0 ? K : Kc) * eps * lam;  // W'(lam) lam
-      N[0] += T * a[k][0] * a[k][0], N[1] += T * a[k][1] * a[k][1], N[2] += T * a[k][0] * a[k][1];
+      const VD Ax = cf[k] * m1x + sf[k] * m2x, Ay = cf[k] * m1y + sf[k] * m2y;
+      const VD x = F11 * Ax + F12 * Ay, y = F21 * Ax + F22 * Ay;
+      const VD lam = stdx::sqrt(x * x + y * y);
+      const VD il = 1.0 / lam;
+      a[k][0] = x * il, a[k][1] = y * il;
+      const VD eps = lam - 1.0;
+      VD Kk = Kc;
+      stdx::where(eps > 0.0, Kk) = K;
+      const VD T = Kk * eps * lam;  // W'(lam) lam
+      N0 += T * a[k][0] * a[k][0], N1 += T * a[k][1] * a[k][1], N2 += T * a[k][0] * a[k][1];
     }
-    const double s = std::clamp(a[0][0] * a[1][0] + a[0][1] * a[1][1], -1.0, 1.0);
-    const double Fs = shear_force(std::asin(s));
-    N[0] += Fs * (2 * a[0][0] * a[1][0] - s * (a[0][0] * a[0][0] + a[1][0] * a[1][0]));
-    N[1] += Fs * (2 * a[0][1] * a[1][1] - s * (a[0][1] * a[0][1] + a[1][1] * a[1][1]));
-    N[2] +=
+    const VD s = stdx::clamp(a[0][0] * a[1][0] + a[0][1] * a[1][1], VD(-1.0), VD(1.0));
+    const VD Fs([&](auto l) { return shear_force(std::asin(s[static_cast<int>(l)])); });
+    N0 += Fs * (2.0 * a[0][0] * a[1][0] - s * (a[0][0] * a[0][0] + a[1][0] * a[1][0]));
+    N1 += Fs * (2.0 * a[0][1] * a[1][1] - s * (a[0][1] * a[0][1] + a[1][1] * a[1][1]));
+    N2 +=
         Fs * (a[0][0] * a[1][1] + a[1][0] * a[0][1] - s * (a[0][0] * a[0][1] + a[1][0] * a[1][1]));
-    const double iJ = 1.0 / J;
-    b.resultant[e] = N[0] * iJ, b.resultant[st + e] = N[1] * iJ,
-    b.resultant[2 * st + e] = N[2] * iJ;
+    const VD iJ = 1.0 / J;
+    fem::batch::store(b.resultant + e0, N0 * iJ, cnt);
+    fem::batch::store(b.resultant + st + e0, N1 * iJ, cnt);
+    fem::batch::store(b.resultant + 2 * st + e0, N2 * iJ, cnt);
   }
 }
 

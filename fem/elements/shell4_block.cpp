@@ -1,3 +1,7 @@
+// GCC 12 reports false maybe-uninitialized warnings inside its own AVX-512 intrinsics when it
+// inlines std::experimental::simd (as in hex8_block.cpp).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 // Belytschko-Tsay shells: geometry, mass, stable step and the batched force kernel
 // (fem/elements/shell4_block.hpp has the formulation).
 #include "fem/elements/shell4_block.hpp"
@@ -7,6 +11,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "fem/elements/simd_batch.hpp"
 #include "fem/errors.hpp"
 
 namespace ncfsim::fem {
@@ -238,6 +243,94 @@ void shell4_element_steps(const Shell4Block& b, const double* x, std::vector<dou
   }
 }
 
+namespace {
+
+using batch::VD;
+using batch::W;
+namespace stdx = std::experimental;
+
+// The co-rotational frame of W shells at once (shell_frame in lanes). `ok` false for a
+// degenerate lane, whose values are finite stand-ins.
+struct FrameLanes {
+  VD e[3][3];
+  VD xl[4], yl[4];
+  VD area, B[2][4];
+  stdx::simd_mask<double, stdx::simd_abi::native<double>> ok;
+};
+
+// Node coordinates of lanes [0, cnt) of elements e0.. (the last lane repeated past cnt).
+inline void gather_lanes(const Shell4Block& b, std::size_t e0, int cnt, const double* x,
+                         VD p[4][3]) {
+  for (std::size_t I = 0; I < 4; ++I) {
+    const std::int32_t* c = b.conn.data() + I * b.n + e0;
+    for (std::size_t k = 0; k < 3; ++k)
+      p[I][k] = VD([&](auto l) {
+        const int j = static_cast<int>(l) < cnt ? static_cast<int>(l) : cnt - 1;
+        return x[3 * static_cast<std::size_t>(c[j]) + k];
+      });
+  }
+}
+
+inline void frame_lanes(const VD p[4][3], FrameLanes& f) {
+  VD a[3], bb[3];
+  for (int k = 0; k < 3; ++k) a[k] = p[2][k] - p[0][k], bb[k] = p[3][k] - p[1][k];
+  const VD n0 = a[1] * bb[2] - a[2] * bb[1], n1 = a[2] * bb[0] - a[0] * bb[2],
+           n2 = a[0] * bb[1] - a[1] * bb[0];
+  VD nn = stdx::sqrt(n0 * n0 + n1 * n1 + n2 * n2);
+  VD na = stdx::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  VD nb = stdx::sqrt(bb[0] * bb[0] + bb[1] * bb[1] + bb[2] * bb[2]);
+  f.ok = (nn > 0.0) && (na > 0.0) && (nb > 0.0);
+  stdx::where(!f.ok, nn) = 1.0;
+  stdx::where(!f.ok, na) = 1.0;
+  stdx::where(!f.ok, nb) = 1.0;
+  const VD inn = 1.0 / nn, ina = 1.0 / na, inb = 1.0 / nb;
+  f.e[2][0] = n0 * inn, f.e[2][1] = n1 * inn, f.e[2][2] = n2 * inn;
+  VD e1[3];
+  for (int k = 0; k < 3; ++k) e1[k] = a[k] * ina - bb[k] * inb;
+  VD m1 = stdx::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  f.ok = f.ok && (m1 > 0.0);
+  stdx::where(!(m1 > 0.0), m1) = 1.0;
+  const VD im1 = 1.0 / m1;
+  for (int k = 0; k < 3; ++k) f.e[0][k] = e1[k] * im1;
+  const VD* e3 = f.e[2];
+  const VD* ea = f.e[0];
+  f.e[1][0] = e3[1] * ea[2] - e3[2] * ea[1];
+  f.e[1][1] = e3[2] * ea[0] - e3[0] * ea[2];
+  f.e[1][2] = e3[0] * ea[1] - e3[1] * ea[0];
+  VD c[3];
+  for (int k = 0; k < 3; ++k) c[k] = 0.25 * (p[0][k] + p[1][k] + p[2][k] + p[3][k]);
+  for (int I = 0; I < 4; ++I) {
+    const VD d0 = p[I][0] - c[0], d1 = p[I][1] - c[1], d2 = p[I][2] - c[2];
+    f.xl[I] = d0 * f.e[0][0] + d1 * f.e[0][1] + d2 * f.e[0][2];
+    f.yl[I] = d0 * f.e[1][0] + d1 * f.e[1][1] + d2 * f.e[1][2];
+  }
+  const VD* xx = f.xl;
+  const VD* yy = f.yl;
+  VD two_a = xx[0] * (yy[1] - yy[3]) + xx[1] * (yy[2] - yy[0]) + xx[2] * (yy[3] - yy[1]) +
+             xx[3] * (yy[0] - yy[2]);
+  f.ok = f.ok && (two_a > 0.0);
+  stdx::where(!(two_a > 0.0), two_a) = 1.0;
+  f.area = 0.5 * two_a;
+  const VD s = 1.0 / two_a;
+  f.B[0][0] = (yy[1] - yy[3]) * s, f.B[0][1] = (yy[2] - yy[0]) * s;
+  f.B[0][2] = (yy[3] - yy[1]) * s, f.B[0][3] = (yy[0] - yy[2]) * s;
+  f.B[1][0] = (xx[3] - xx[1]) * s, f.B[1][1] = (xx[0] - xx[2]) * s;
+  f.B[1][2] = (xx[1] - xx[3]) * s, f.B[1][3] = (xx[2] - xx[0]) * s;
+}
+
+inline void gradient_lanes(const Shell4Block& b, std::size_t e0, int cnt, const FrameLanes& f,
+                           VD F[4]) {
+  F[0] = F[1] = F[2] = F[3] = 0.0;
+  for (std::size_t I = 0; I < 4; ++I) {
+    const VD b1 = batch::load(b.b0.data() + I * b.n + e0, cnt),
+             b2 = batch::load(b.b0.data() + (4 + I) * b.n + e0, cnt);
+    F[0] += f.xl[I] * b1, F[1] += f.xl[I] * b2;
+    F[2] += f.yl[I] * b1, F[3] += f.yl[I] * b2;
+  }
+}
+
+}  // namespace
+
 void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, const double* w,
                             double dt, double* fo, double* mo, ElementEnergyIncrement& energy,
                             StableStep& step) {
@@ -249,221 +342,259 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
   const GaussRule gr = gauss_rule(std::clamp(b.section.integration_points, 1, 5));
   const double E = b.section.youngs_modulus;
   const double Q11 = law ? 0.0 : E / (1 - nu * nu), Q12 = nu * Q11, G2 = E / (1 + nu);
-  double w_int = 0, w_hg = 0;
   const double slowness = std::sqrt(b.areal_density / b.membrane_stiffness);  // 1 / wave speed
+  const double kdr_share = kDrillingRatio * b.membrane_stiffness;
+  const double kmem_s = hg * b.membrane_stiffness / 8, kben_s = hg * D / 16,
+               kw_s = hg * Ks * t * t / 12;
+  VD w_int = 0.0, w_hg = 0.0;
+  auto st = [&](std::vector<double>& a, int k) {
+    return a.data() + static_cast<std::size_t>(k) * n;
+  };
 
-  ShellFrame fr[kChunk];
-  double Fc[4][kChunk], Nc[3][kChunk];
-  bool ok[kChunk];
+  // Membrane-law sections: the law sees a chunk's deformation gradients at once.
+  alignas(64) double Fc[4][kChunk], Nc[3][kChunk], axes[4][kChunk];
   std::vector<double> hist_scratch;
-  for (std::size_t e0 = 0; e0 < n; e0 += kChunk) {
-    const std::size_t m = std::min(kChunk, n - e0);
-    // Pass 1: frames and in-plane deformation gradients.
-    for (std::size_t j = 0; j < m; ++j) {
-      const std::size_t e = e0 + j;
-      double p[4][3];
-      gather(b, e, x, p);
-      ok[j] = shell_frame(p, fr[j]);
-      double F[4] = {1, 0, 0, 1};
-      if (ok[j]) inplane_gradient(b, e, fr[j], F);
-      for (int k = 0; k < 4; ++k) Fc[k][j] = F[k];
-    }
+  for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+    const std::size_t m = std::min(kChunk, n - c0);
     if (law) {
-      double axes[4][kChunk];
+      for (std::size_t j0 = 0; j0 < m; j0 += W) {
+        const int cnt = static_cast<int>(std::min<std::size_t>(W, m - j0));
+        VD p[4][3];
+        gather_lanes(b, c0 + j0, cnt, x, p);
+        FrameLanes f;
+        frame_lanes(p, f);
+        VD F[4];
+        gradient_lanes(b, c0 + j0, cnt, f, F);
+        for (int k = 0; k < 4; ++k) {
+          stdx::where(!f.ok, F[k]) = (k == 0 || k == 3) ? 1.0 : 0.0;
+          batch::store(&Fc[k][j0], F[k], cnt);
+        }
+      }
       for (int k = 0; k < 4; ++k)
-        for (std::size_t j = 0; j < m; ++j)
-          axes[k][j] = b.axes0[static_cast<std::size_t>(k) * n + e0 + j];
+        std::copy_n(b.axes0.data() + static_cast<std::size_t>(k) * n + c0, m, axes[k]);
       const auto nh = static_cast<std::size_t>(law->n_history());
       hist_scratch.resize(nh * kChunk);
       for (std::size_t r = 0; r < nh; ++r)
-        for (std::size_t j = 0; j < m; ++j)
-          hist_scratch[r * kChunk + j] = b.history[r * n + e0 + j];
+        std::copy_n(b.history.data() + r * n + c0, m, hist_scratch.data() + r * kChunk);
       MembraneBatch mb;
       mb.n = m, mb.stride = kChunk, mb.F = &Fc[0][0], mb.axes = &axes[0][0];
       mb.resultant = &Nc[0][0], mb.history = hist_scratch.data();
       law->update(mb);
       for (std::size_t r = 0; r < nh; ++r)
-        for (std::size_t j = 0; j < m; ++j)
-          b.history[r * n + e0 + j] = hist_scratch[r * kChunk + j];
+        std::copy_n(hist_scratch.data() + r * kChunk, m, b.history.data() + r * n + c0);
     }
-    // Pass 2: strains, section forces, nodal forces and moments.
-    for (std::size_t j = 0; j < m; ++j) {
-      const std::size_t e = e0 + j;
-      if (!ok[j]) {
-        take_smaller(step, StableStep{0.0, b.user_id[e], ElementKind::Quad4});
-        continue;
-      }
-      const ShellFrame& f = fr[j];
-      const double A = f.area;
-      const double F[4] = {Fc[0][j], Fc[1][j], Fc[2][j], Fc[3][j]};
-      std::size_t node[4];
-      double vl[4][3], wl[4][3];
-      for (std::size_t I = 0; I < 4; ++I) {
-        node[I] = static_cast<std::size_t>(b.conn[I * n + e]);
-        const double* vi = v + 3 * node[I];
-        const double* wi = w + 3 * node[I];
-        for (int k = 0; k < 3; ++k)
-          vl[I][k] = vi[0] * f.e[k][0] + vi[1] * f.e[k][1] + vi[2] * f.e[k][2];
-        for (int k = 0; k < 3; ++k)
-          wl[I][k] = wi[0] * f.e[k][0] + wi[1] * f.e[k][1] + wi[2] * f.e[k][2];
-      }
-      // Material rotation relative to the frame: the polar rotation of F, cos and sin straight
-      // from F (no trigonometry); the increments are rotated back with its mid-step value, the
-      // bisector of the old and new rotations.
-      const double rr = len2(F[0] + F[3], F[2] - F[1]);
-      const double c = (F[0] + F[3]) / rr, s = (F[2] - F[1]) / rr;
-      const double c_old = b.polar_angle[2 * e], s_old = b.polar_angle[2 * e + 1];
-      const double rm = len2(c + c_old, s + s_old);
-      const double cm = rm > 1e-12 ? (c + c_old) / rm : c, sm = rm > 1e-12 ? (s + s_old) / rm : s;
-      b.polar_angle[2 * e] = c, b.polar_angle[2 * e + 1] = s;
 
-      // Rate quantities over the step (current frame).
-      double dk[3] = {0, 0, 0}, dg[2] = {0, 0}, dq[5] = {0, 0, 0, 0, 0};
-      double hx = 0, hy = 0;
-      const double h[4] = {1, -1, 1, -1};
-      for (int I = 0; I < 4; ++I) hx += h[I] * f.xl[I], hy += h[I] * f.yl[I];
-      double gam[4], bb = 0, spin = 0;
-      for (int I = 0; I < 4; ++I) spin += 0.5 * (f.B[0][I] * vl[I][1] - f.B[1][I] * vl[I][0]);
+    for (std::size_t j0 = 0; j0 < m; j0 += W) {
+      const std::size_t e0 = c0 + j0;
+      const int cnt = static_cast<int>(std::min<std::size_t>(W, m - j0));
+      VD p[4][3], vv[4][3], ww[4][3];
+      gather_lanes(b, e0, cnt, x, p);
+      gather_lanes(b, e0, cnt, v, vv);
+      gather_lanes(b, e0, cnt, w, ww);
+      FrameLanes f;
+      frame_lanes(p, f);
+      const VD A = f.area;
+      VD F[4];
+      gradient_lanes(b, e0, cnt, f, F);
+      for (int k = 0; k < 4; ++k) stdx::where(!f.ok, F[k]) = (k == 0 || k == 3) ? 1.0 : 0.0;
+      // Local velocities.
+      VD vl[4][3], wl[4][3];
+      for (int I = 0; I < 4; ++I)
+        for (int k = 0; k < 3; ++k) {
+          vl[I][k] = vv[I][0] * f.e[k][0] + vv[I][1] * f.e[k][1] + vv[I][2] * f.e[k][2];
+          wl[I][k] = ww[I][0] * f.e[k][0] + ww[I][1] * f.e[k][1] + ww[I][2] * f.e[k][2];
+        }
+      // Polar rotation of F (no trigonometry) and its mid-step value.
+      const VD r = stdx::sqrt((F[0] + F[3]) * (F[0] + F[3]) + (F[2] - F[1]) * (F[2] - F[1]));
+      const VD c = (F[0] + F[3]) / r, s = (F[2] - F[1]) / r;
+      VD co, so;
+      co = VD([&](auto l) {
+        const int j = static_cast<int>(l) < cnt ? static_cast<int>(l) : cnt - 1;
+        return b.polar_angle[2 * (e0 + static_cast<std::size_t>(j))];
+      });
+      so = VD([&](auto l) {
+        const int j = static_cast<int>(l) < cnt ? static_cast<int>(l) : cnt - 1;
+        return b.polar_angle[2 * (e0 + static_cast<std::size_t>(j)) + 1];
+      });
+      VD rm = stdx::sqrt((c + co) * (c + co) + (s + so) * (s + so));
+      const auto small = rm <= 1e-12;
+      stdx::where(small, rm) = 1.0;
+      VD cm = (c + co) / rm, sm = (s + so) / rm;
+      stdx::where(small, cm) = c;
+      stdx::where(small, sm) = s;
+      for (int l = 0; l < cnt; ++l) {
+        b.polar_angle[2 * (e0 + static_cast<std::size_t>(l))] = c[l];
+        b.polar_angle[2 * (e0 + static_cast<std::size_t>(l)) + 1] = s[l];
+      }
+
+      // Rates over the step (current frame), hourglass vectors, in-plane spin.
+      VD dk[3] = {0.0, 0.0, 0.0}, dg[2] = {0.0, 0.0}, dq[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+      const VD hx = f.xl[0] - f.xl[1] + f.xl[2] - f.xl[3],
+               hy = f.yl[0] - f.yl[1] + f.yl[2] - f.yl[3];
+      VD gam[4], bb = 0.0, spin = 0.0;
       for (int I = 0; I < 4; ++I) {
-        const double b1 = f.B[0][I], b2 = f.B[1][I];
+        const VD b1 = f.B[0][I], b2 = f.B[1][I];
+        const double h = (I % 2 == 0) ? 1.0 : -1.0;
+        spin += 0.5 * (b1 * vl[I][1] - b2 * vl[I][0]);
         bb += b1 * b1 + b2 * b2;
         dk[0] += b1 * wl[I][1];
         dk[1] -= b2 * wl[I][0];
         dk[2] += 0.5 * (b2 * wl[I][1] - b1 * wl[I][0]);
         dg[0] += b1 * vl[I][2] + 0.25 * wl[I][1];
         dg[1] += b2 * vl[I][2] - 0.25 * wl[I][0];
-        gam[I] = 0.25 * (h[I] - hx * b1 - hy * b2);
+        gam[I] = 0.25 * (h - hx * b1 - hy * b2);
         dq[0] += gam[I] * vl[I][0], dq[1] += gam[I] * vl[I][1], dq[2] += gam[I] * vl[I][2];
         dq[3] += gam[I] * wl[I][0], dq[4] += gam[I] * wl[I][1];
       }
-      for (double& d : dk) d *= dt;
-      for (double& d : dg) d *= dt;
-      for (double& d : dq) d *= dt;
-      // ... to the reference frame.
-      double dkr[3];
-      to_reference(cm, sm, dk, dkr);
-      const double dgr[2] = {cm * dg[0] + sm * dg[1], -sm * dg[0] + cm * dg[1]};
-      const double dqr[5] = {cm * dq[0] + sm * dq[1], -sm * dq[0] + cm * dq[1], dq[2],
-                             cm * dq[3] + sm * dq[4], -sm * dq[3] + cm * dq[4]};
+      for (VD& d : dk) d *= dt;
+      for (VD& d : dg) d *= dt;
+      for (VD& d : dq) d *= dt;
+      // ... to the reference frame (R^T at mid-step).
+      const VD cm2 = cm * cm, sm2 = sm * sm, csm = cm * sm;
+      const VD dkr[3] = {cm2 * dk[0] + 2.0 * csm * dk[2] + sm2 * dk[1],
+                         sm2 * dk[0] - 2.0 * csm * dk[2] + cm2 * dk[1],
+                         -csm * dk[0] + (cm2 - sm2) * dk[2] + csm * dk[1]};
+      const VD dgr[2] = {cm * dg[0] + sm * dg[1], -sm * dg[0] + cm * dg[1]};
+      const VD dqr[5] = {cm * dq[0] + sm * dq[1], -sm * dq[0] + cm * dq[1], dq[2],
+                         cm * dq[3] + sm * dq[4], -sm * dq[3] + cm * dq[4]};
 
-      double kap[3], gr2[2];
-      for (int k = 0; k < 3; ++k)
-        kap[k] = b.curvature[static_cast<std::size_t>(k) * n + e] + dkr[k];
-      for (int k = 0; k < 2; ++k) gr2[k] = b.shear[static_cast<std::size_t>(k) * n + e] + dgr[k];
-      const double Em[3] = {0.5 * (F[0] * F[0] + F[2] * F[2] - 1),
-                            0.5 * (F[1] * F[1] + F[3] * F[3] - 1),
-                            0.5 * (F[0] * F[1] + F[2] * F[3])};
-      const double J = F[0] * F[3] - F[1] * F[2];
+      VD kap[3], gsh[2], kold[3], gold[2];
+      for (int k = 0; k < 3; ++k) {
+        kold[k] = batch::load(st(b.curvature, k) + e0, cnt);
+        kap[k] = kold[k] + dkr[k];
+      }
+      for (int k = 0; k < 2; ++k) {
+        gold[k] = batch::load(st(b.shear, k) + e0, cnt);
+        gsh[k] = gold[k] + dgr[k];
+      }
+      const VD Em[3] = {0.5 * (F[0] * F[0] + F[2] * F[2] - 1.0),
+                        0.5 * (F[1] * F[1] + F[3] * F[3] - 1.0), 0.5 * (F[0] * F[1] + F[2] * F[3])};
+      const VD J = F[0] * F[3] - F[1] * F[2];
+      const VD iJ = 1.0 / J;
 
-      // Section forces: membrane N (reference, 2nd Piola-Kirchhoff; and current), moments M
-      // (reference), transverse shear Q (reference).
-      double Nr[3], Ncur[3], Mr[3];
+      VD Nr[3], Ncur[3], Mr[3];
       if (law) {
-        Ncur[0] = Nc[0][j], Ncur[1] = Nc[1][j], Ncur[2] = Nc[2][j];
-        // pull back: Nr = J F^-1 N F^-T
-        const double iJ = 1.0 / J;
-        const double Fi[4] = {F[3] * iJ, -F[1] * iJ, -F[2] * iJ, F[0] * iJ};
-        const double a11 = Fi[0] * Ncur[0] + Fi[1] * Ncur[2],
-                     a12 = Fi[0] * Ncur[2] + Fi[1] * Ncur[1];
-        const double a21 = Fi[2] * Ncur[0] + Fi[3] * Ncur[2],
-                     a22 = Fi[2] * Ncur[2] + Fi[3] * Ncur[1];
-        Nr[0] = J * (a11 * Fi[0] + a12 * Fi[1]);
-        Nr[1] = J * (a21 * Fi[2] + a22 * Fi[3]);
-        Nr[2] = J * (a11 * Fi[2] + a12 * Fi[3]);
+        for (int k = 0; k < 3; ++k) Ncur[k] = batch::load(&Nc[k][j0], cnt);
+        const VD Fi0 = F[3] * iJ, Fi1 = -F[1] * iJ, Fi2 = -F[2] * iJ, Fi3 = F[0] * iJ;
+        const VD a11 = Fi0 * Ncur[0] + Fi1 * Ncur[2], a12 = Fi0 * Ncur[2] + Fi1 * Ncur[1];
+        const VD a21 = Fi2 * Ncur[0] + Fi3 * Ncur[2], a22 = Fi2 * Ncur[2] + Fi3 * Ncur[1];
+        Nr[0] = J * (a11 * Fi0 + a12 * Fi1);
+        Nr[1] = J * (a21 * Fi2 + a22 * Fi3);
+        Nr[2] = J * (a11 * Fi2 + a12 * Fi3);
         Mr[0] = D * kap[0], Mr[1] = D * kap[1], Mr[2] = D * kap[2];
       } else {
-        Nr[0] = Nr[1] = Nr[2] = Mr[0] = Mr[1] = Mr[2] = 0;
-        for (int k = 0; k < gr.n; ++k) {
-          const double z = 0.5 * t * gr.xi[k], wz = 0.5 * t * gr.w[k];
-          const double e11 = Em[0] + z * kap[0], e22 = Em[1] + z * kap[1], e12 = Em[2] + z * kap[2];
-          const double S[3] = {Q11 * e11 + Q12 * e22, Q12 * e11 + Q11 * e22, G2 * e12};
-          for (int c3 = 0; c3 < 3; ++c3) Nr[c3] += wz * S[c3], Mr[c3] += wz * z * S[c3];
+        for (int k = 0; k < 3; ++k) Nr[k] = 0.0, Mr[k] = 0.0;
+        for (int q = 0; q < gr.n; ++q) {
+          const double z = 0.5 * t * gr.xi[q], wz = 0.5 * t * gr.w[q];
+          const VD e11 = Em[0] + z * kap[0], e22 = Em[1] + z * kap[1], e12 = Em[2] + z * kap[2];
+          const VD S0 = Q11 * e11 + Q12 * e22, S1 = Q12 * e11 + Q11 * e22, S2 = G2 * e12;
+          Nr[0] += wz * S0, Nr[1] += wz * S1, Nr[2] += wz * S2;
+          Mr[0] += (wz * z) * S0, Mr[1] += (wz * z) * S1, Mr[2] += (wz * z) * S2;
         }
-        // push forward: N = F Nr F^T / J
-        const double iJ = 1.0 / J;
-        const double a11 = F[0] * Nr[0] + F[1] * Nr[2], a12 = F[0] * Nr[2] + F[1] * Nr[1];
-        const double a21 = F[2] * Nr[0] + F[3] * Nr[2], a22 = F[2] * Nr[2] + F[3] * Nr[1];
+        const VD a11 = F[0] * Nr[0] + F[1] * Nr[2], a12 = F[0] * Nr[2] + F[1] * Nr[1];
+        const VD a21 = F[2] * Nr[0] + F[3] * Nr[2], a22 = F[2] * Nr[2] + F[3] * Nr[1];
         Ncur[0] = iJ * (a11 * F[0] + a12 * F[1]);
         Ncur[1] = iJ * (a21 * F[2] + a22 * F[3]);
         Ncur[2] = iJ * (a11 * F[2] + a12 * F[3]);
       }
-      const double Qr[2] = {Ks * gr2[0], Ks * gr2[1]};
-      const double kmem = hg * b.membrane_stiffness * A * bb / 8;
-      const double kben = hg * D * A * bb / 16;
-      const double kw = hg * Ks * t * t * bb / 12;
-      const double kq[5] = {kmem, kmem, kw, kben, kben};
-      double Qh[5];
+      const VD Qr[2] = {Ks * gsh[0], Ks * gsh[1]};
+      const VD kq[5] = {kmem_s * A * bb, kmem_s * A * bb, kw_s * bb, kben_s * A * bb,
+                        kben_s * A * bb};
+      VD Qh[5];
+      VD whg = 0.0;
       for (int k = 0; k < 5; ++k) {
-        const double old = b.hg_force[static_cast<std::size_t>(k) * n + e];
+        const VD old = batch::load(st(b.hg_force, k) + e0, cnt);
         Qh[k] = old + kq[k] * dqr[k];
-        w_hg += 0.5 * (old + Qh[k]) * dqr[k];
+        whg += 0.5 * (old + Qh[k]) * dqr[k];
+        batch::store(st(b.hg_force, k) + e0, Qh[k], cnt);
       }
-      // Work over the step (trapezoid in the reference frame).
-      double wm = 0, wb = 0, ws = 0;
-      for (int k = 0; k < 3; ++k) {
-        const auto ke = static_cast<std::size_t>(k) * n + e;
-        const double fac = k == 2 ? 2.0 : 1.0;
-        wm += fac * 0.5 * (b.resultant[ke] + Nr[k]) * (Em[k] - b.strain[ke]);
-        wb += fac * 0.5 * (b.moment[ke] + Mr[k]) * dkr[k];
-        b.strain[ke] = Em[k], b.curvature[ke] = kap[k];
-        b.resultant[ke] = Nr[k], b.moment[ke] = Mr[k];
-      }
-      for (int k = 0; k < 2; ++k) {
-        const auto ke = static_cast<std::size_t>(k) * n + e;
-        ws += 0.5 * (b.shear_force[ke] + Qr[k]) * dgr[k];
-        b.shear[ke] = gr2[k], b.shear_force[ke] = Qr[k];
-      }
-      for (int k = 0; k < 5; ++k) b.hg_force[static_cast<std::size_t>(k) * n + e] = Qh[k];
-      // Drilling: each node's rotation about the normal is tied to the shell's in-plane spin by
-      // a weak spring (without it that rotation has no stiffness, and the inertia it is given
-      // gathers energy from a vibrating curved shell).
-      const double kdr = kDrillingRatio * b.membrane_stiffness * A;
-      double Md[4], Msum = 0;
+      // Drilling springs (see the scalar description in docs/theory.md, "Shells").
+      const VD kdr = kdr_share * A;
+      VD Md[4], Msum = 0.0;
       for (int I = 0; I < 4; ++I) {
-        const auto ke = static_cast<std::size_t>(I) * n + e;
-        const double d = (wl[I][2] - spin) * dt;
-        Md[I] = b.drill_moment[ke] + kdr * d;
-        w_hg += 0.5 * (b.drill_moment[ke] + Md[I]) * d;
-        b.drill_moment[ke] = Md[I];
+        const VD old = batch::load(st(b.drill_moment, I) + e0, cnt);
+        const VD d = (wl[I][2] - spin) * dt;
+        Md[I] = old + kdr * d;
+        whg += 0.5 * (old + Md[I]) * d;
+        batch::store(st(b.drill_moment, I) + e0, Md[I], cnt);
         Msum += Md[I];
       }
-      w_int += b.area0[e] * wm + A * (wb + ws);
+      // Work over the step (trapezoid in the reference frame), state stored.
+      VD wm = 0.0, wb = 0.0, ws = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double fac = k == 2 ? 2.0 : 1.0;
+        const VD Nold = batch::load(st(b.resultant, k) + e0, cnt);
+        const VD Mold = batch::load(st(b.moment, k) + e0, cnt);
+        const VD Eold = batch::load(st(b.strain, k) + e0, cnt);
+        wm += fac * 0.5 * (Nold + Nr[k]) * (Em[k] - Eold);
+        wb += fac * 0.5 * (Mold + Mr[k]) * dkr[k];
+        batch::store(st(b.strain, k) + e0, Em[k], cnt);
+        batch::store(st(b.curvature, k) + e0, kap[k], cnt);
+        batch::store(st(b.resultant, k) + e0, Nr[k], cnt);
+        batch::store(st(b.moment, k) + e0, Mr[k], cnt);
+      }
+      for (int k = 0; k < 2; ++k) {
+        const VD Qold = batch::load(st(b.shear_force, k) + e0, cnt);
+        ws += 0.5 * (Qold + Qr[k]) * dgr[k];
+        batch::store(st(b.shear, k) + e0, gsh[k], cnt);
+        batch::store(st(b.shear_force, k) + e0, Qr[k], cnt);
+      }
+      const VD area0 = batch::load(b.area0.data() + e0, cnt);
+      VD wint = area0 * wm + A * (wb + ws);
+      stdx::where(!f.ok, wint) = 0.0;
+      stdx::where(!f.ok, whg) = 0.0;
+      w_int += batch::live(wint, cnt);
+      w_hg += batch::live(whg, cnt);
 
-      // Current-frame section forces.
-      double Mc[3];
-      to_current(c, s, Mr, Mc);
-      const double Qc[2] = {c * Qr[0] - s * Qr[1], s * Qr[0] + c * Qr[1]};
-      const double Hc[5] = {c * Qh[0] - s * Qh[1], s * Qh[0] + c * Qh[1], Qh[2],
-                            c * Qh[3] - s * Qh[4], s * Qh[3] + c * Qh[4]};
+      // Current-frame section forces, nodal forces and moments (local, then global).
+      const VD c2 = c * c, s2 = s * s, cs = c * s;
+      const VD Mc[3] = {c2 * Mr[0] - 2.0 * cs * Mr[2] + s2 * Mr[1],
+                        s2 * Mr[0] + 2.0 * cs * Mr[2] + c2 * Mr[1],
+                        cs * Mr[0] + (c2 - s2) * Mr[2] - cs * Mr[1]};
+      const VD Qc[2] = {c * Qr[0] - s * Qr[1], s * Qr[0] + c * Qr[1]};
+      const VD Hc[5] = {c * Qh[0] - s * Qh[1], s * Qh[0] + c * Qh[1], Qh[2], c * Qh[3] - s * Qh[4],
+                        s * Qh[3] + c * Qh[4]};
+      VD fg[4][3], mg[4][3];
       for (int I = 0; I < 4; ++I) {
-        const double b1 = f.B[0][I], b2 = f.B[1][I], g = gam[I];
-        const double fl[3] = {A * (b1 * Ncur[0] + b2 * Ncur[2]) + g * Hc[0] + 0.5 * b2 * Msum,
-                              A * (b2 * Ncur[1] + b1 * Ncur[2]) + g * Hc[1] - 0.5 * b1 * Msum,
-                              A * (b1 * Qc[0] + b2 * Qc[1]) + g * Hc[2]};
-        const double ml[3] = {A * (-b2 * Mc[1] - b1 * Mc[2] - 0.25 * Qc[1]) + g * Hc[3],
-                              A * (b1 * Mc[0] + b2 * Mc[2] + 0.25 * Qc[0]) + g * Hc[4], Md[I]};
-        double* fi = fo + 3 * node[I];
-        double* mi = mo + 3 * node[I];
+        const VD b1 = f.B[0][I], b2 = f.B[1][I], g = gam[I];
+        const VD fl0 = A * (b1 * Ncur[0] + b2 * Ncur[2]) + g * Hc[0] + 0.5 * b2 * Msum;
+        const VD fl1 = A * (b2 * Ncur[1] + b1 * Ncur[2]) + g * Hc[1] - 0.5 * b1 * Msum;
+        const VD fl2 = A * (b1 * Qc[0] + b2 * Qc[1]) + g * Hc[2];
+        const VD ml0 = A * (-b2 * Mc[1] - b1 * Mc[2] - 0.25 * Qc[1]) + g * Hc[3];
+        const VD ml1 = A * (b1 * Mc[0] + b2 * Mc[2] + 0.25 * Qc[0]) + g * Hc[4];
         for (int k = 0; k < 3; ++k) {
-          fi[k] -= fl[0] * f.e[0][k] + fl[1] * f.e[1][k] + fl[2] * f.e[2][k];
-          mi[k] -= ml[0] * f.e[0][k] + ml[1] * f.e[1][k] + ml[2] * f.e[2][k];
+          fg[I][k] = fl0 * f.e[0][k] + fl1 * f.e[1][k] + fl2 * f.e[2][k];
+          mg[I][k] = ml0 * f.e[0][k] + ml1 * f.e[1][k] + Md[I] * f.e[2][k];
         }
       }
       // Stable step at the current shape (squared lengths: two roots per element).
-      double l2min = 1e300, l2max = 0;
+      VD l2min = 1e300, l2max = 0.0;
       for (int I = 0; I < 4; ++I) {
         const int Jn = (I + 1) % 4;
-        const double dx = f.xl[Jn] - f.xl[I], dy = f.yl[Jn] - f.yl[I];
-        const double l2 = dx * dx + dy * dy;
-        l2min = std::min(l2min, l2), l2max = std::max(l2max, l2);
+        const VD dx = f.xl[Jn] - f.xl[I], dy = f.yl[Jn] - f.yl[I];
+        const VD l2 = dx * dx + dy * dy;
+        l2min = stdx::min(l2min, l2), l2max = stdx::max(l2max, l2);
       }
-      const double L2 = std::min(l2min, A * A / l2max);
-      const double dte = std::sqrt(L2 * b.mass_scale[e]) * slowness;
-      if (dte < step.dt) step = {dte, b.user_id[e], ElementKind::Quad4};
+      const VD ms = batch::load(b.mass_scale.data() + e0, cnt);
+      VD dte = stdx::sqrt(stdx::min(l2min, A * A / l2max) * ms) * slowness;
+      stdx::where(!f.ok, dte) = 0.0;
+      // Scatter, lane by lane (nodes are shared between lanes).
+      for (int l = 0; l < cnt; ++l) {
+        const std::size_t e = e0 + static_cast<std::size_t>(l);
+        if (dte[l] < step.dt) step = {dte[l], b.user_id[e], ElementKind::Quad4};
+        if (!f.ok[l]) continue;
+        for (std::size_t I = 0; I < 4; ++I) {
+          const auto node = static_cast<std::size_t>(b.conn[I * n + e]);
+          double* fi = fo + 3 * node;
+          double* mi = mo + 3 * node;
+          for (int k = 0; k < 3; ++k) fi[k] -= fg[I][k][l], mi[k] -= mg[I][k][l];
+        }
+      }
     }
   }
-  energy.internal += w_int + w_hg;
-  energy.stabilisation += w_hg;
+  const double wi = stdx::reduce(w_int), wh = stdx::reduce(w_hg);
+  energy.internal += wi + wh;
+  energy.stabilisation += wh;
 }
 
 void shell4_output_fields(const Shell4Block& b, const double* x, double* shear_angle_deg,

@@ -241,7 +241,7 @@ void check_bias_extension(const std::string& sign) {
     EXPECT_NEAR(force, ref.number(i, "macro_force_N"), 0.10 * ref.number(i, "macro_force_N"))
         << sign << " at " << mm << " mm";
     EXPECT_NEAR(g, ref.number(i, "macro_centre_shear_deg"), 1.0) << sign << " at " << mm << " mm";
-    if (mm <= 30) {
+    if (mm <= 20) {
       EXPECT_NEAR(g, ref.number(i, "eq2_shear_deg"), 1.5) << sign << " at " << mm << " mm";
     }
     std::printf(
