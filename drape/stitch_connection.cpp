@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fem/checkpoint.hpp"
 #include "fem/errors.hpp"
 #include "fem/mesh.hpp"
 
@@ -276,5 +277,34 @@ void StitchToTowConnection::erode(const std::vector<std::int32_t>& mesh_elements
 }
 
 std::vector<fem::ContactResultant> StitchToTowConnection::resultants() const { return {{name_, total_}}; }
+
+void StitchToTowConnection::save_state(fem::CheckpointWriter& w) const {
+  w.write_int("n_joints", static_cast<std::int64_t>(a_.size()));
+  fem::save_array(w, "rest", rest_);
+  fem::save_array(w, "slip_length", slip_len_);
+  fem::save_array(w, "force", force_);
+  fem::save_array(w, "joint_slot", joint_slot_);
+  fem::save_array(w, "slot_hex", slot_hex_);
+  w.write_int("n_released", static_cast<std::int64_t>(n_released_));
+  w.write_double("dissipated", dissipated_);
+  w.write_int("n_sliding", n_sliding_);
+  const double t[3] = {total_.x, total_.y, total_.z};
+  w.write_array("total", std::span<const double>(t, 3));
+}
+
+void StitchToTowConnection::load_state(fem::CheckpointReader& r) {
+  r.check_int("n_joints", static_cast<std::int64_t>(a_.size()));
+  fem::load_array(r, "rest", rest_);
+  fem::load_array(r, "slip_length", slip_len_);
+  fem::load_array(r, "force", force_);
+  fem::load_array(r, "joint_slot", joint_slot_);
+  fem::load_array(r, "slot_hex", slot_hex_);
+  n_released_ = static_cast<std::size_t>(r.read_int("n_released"));
+  dissipated_ = r.read_double("dissipated");
+  n_sliding_ = r.read_int("n_sliding");
+  double t[3];
+  r.read_into("total", t, 3);
+  total_ = {t[0], t[1], t[2]};
+}
 
 }  // namespace ncfsim::drape

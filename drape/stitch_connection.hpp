@@ -38,6 +38,8 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   /// A joint whose axis hexahedron (one holding its tow node and axis node) is eroded is
   /// released: that piece of tow is gone and gives no axis.
   void erode(const std::vector<std::int32_t>& mesh_elements) override;
+  void save_state(fem::CheckpointWriter& w) const override;
+  void load_state(fem::CheckpointReader& r) override;
   /// Joints released by erosion so far.
   std::size_t released() const { return n_released_; }
 

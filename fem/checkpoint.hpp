@@ -107,6 +107,16 @@ class CheckpointScope {
   Io& io_;
 };
 
+/// A state vector into a checkpoint, and back at the size it has in the rebuilt model.
+template <class T>
+void save_array(CheckpointWriter& w, const std::string& name, const std::vector<T>& v) {
+  w.write_array(name, std::span<const T>(v));
+}
+template <class T>
+void load_array(const CheckpointReader& r, const std::string& name, std::vector<T>& v) {
+  r.read_array(name, v, v.size());
+}
+
 /// Zero-padded group index ("007") so that groups list in order.
 inline std::string checkpoint_index(std::size_t i) {
   std::string s = std::to_string(i);

@@ -11,6 +11,8 @@
 namespace ncfsim::fem {
 
 struct Mesh;
+class CheckpointWriter;
+class CheckpointReader;
 
 /// What a contact may read when it is set up (after masses are assembled, before cycle 0).
 struct ContactSetup {
@@ -51,6 +53,11 @@ class ContactAlgorithm {
   /// index in its set) were eroded: their faces stop being contact segments from the next
   /// add_forces on, and the faces of their neighbours that they covered start being ones.
   virtual void erode(const std::vector<std::int32_t>& mesh_elements) { (void)mesh_elements; }
+  /// The contact's state carried from cycle to cycle into a checkpoint, and back into a contact
+  /// built and initialised from the same case (fem/checkpoint.hpp; CheckpointMismatch when it
+  /// does not fit). Called at a cycle boundary only.
+  virtual void save_state(CheckpointWriter& w) const = 0;
+  virtual void load_state(CheckpointReader& r) = 0;
 };
 
 }  // namespace ncfsim::fem

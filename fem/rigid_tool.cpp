@@ -11,6 +11,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "fem/checkpoint.hpp"
+
 namespace ncfsim::fem {
 
 namespace {
@@ -334,6 +336,64 @@ void remove_tool_contact_nodes(RigidTool& tool, const std::vector<std::uint8_t>&
   tool.contact_nodes.resize(k);
   if (has_state) tool.tangential.resize(3 * k);
   tool.proximity.valid = false;
+}
+
+namespace {
+void save_v3(CheckpointWriter& w, const std::string& name, const V3& v) {
+  const double a[3] = {v.x, v.y, v.z};
+  w.write_array(name, std::span<const double>(a, 3));
+}
+V3 load_v3(const CheckpointReader& r, const std::string& name) {
+  double a[3];
+  r.read_into(name, a, 3);
+  return {a[0], a[1], a[2]};
+}
+}  // namespace
+
+void save_tool_state(const RigidTool& tool, CheckpointWriter& w) {
+  save_v3(w, "displacement", tool.displacement);
+  save_v3(w, "velocity", tool.velocity);
+  save_v3(w, "force", tool.force);
+  save_array(w, "contact_nodes", tool.contact_nodes);
+  save_array(w, "tangential", tool.tangential);
+  w.write_double("friction_dissipation", tool.friction_dissipation);
+  w.write_int("n_active", tool.n_active);
+  w.write_double("max_penetration", tool.max_penetration);
+  const ToolProximity& p = tool.proximity;
+  w.write_double("proximity_margin", p.margin);
+  save_array(w, "proximity_near", p.near);
+  save_array(w, "proximity_x_ref", p.x_ref);
+  save_v3(w, "proximity_tool_ref", p.tool_ref);
+  w.write_int("proximity_rebuilds", p.n_rebuilds);
+  w.write_int("proximity_valid", p.valid ? 1 : 0);
+}
+
+void load_tool_state(RigidTool& tool, CheckpointReader& r) {
+  tool.displacement = load_v3(r, "displacement");
+  tool.velocity = load_v3(r, "velocity");
+  tool.force = load_v3(r, "force");
+  // Erosion only takes contact nodes out: the saved list is a subsequence of the rebuilt one.
+  std::vector<std::int32_t> nodes;
+  r.read_array("contact_nodes", nodes);
+  if (nodes.size() > tool.contact_nodes.size())
+    r.mismatch("contact_nodes", "has " + std::to_string(nodes.size()) +
+                                    " nodes, this model's tool has " +
+                                    std::to_string(tool.contact_nodes.size()));
+  tool.contact_nodes = std::move(nodes);
+  r.read_array("tangential", tool.tangential, 3 * tool.contact_nodes.size());
+  tool.friction_dissipation = r.read_double("friction_dissipation");
+  tool.n_active = r.read_int("n_active");
+  tool.max_penetration = r.read_double("max_penetration");
+  ToolProximity& p = tool.proximity;
+  p.margin = r.read_double("proximity_margin");
+  r.read_array("proximity_near", p.near);
+  r.read_array("proximity_x_ref", p.x_ref);
+  p.tool_ref = load_v3(r, "proximity_tool_ref");
+  p.n_rebuilds = r.read_int("proximity_rebuilds");
+  p.valid = r.read_int("proximity_valid") != 0;
+  for (auto k : p.near)
+    if (k < 0 || static_cast<std::size_t>(k) >= tool.contact_nodes.size())
+      r.mismatch("proximity_near", "names a contact node the tool does not have");
 }
 
 }  // namespace ncfsim::fem

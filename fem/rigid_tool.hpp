@@ -13,6 +13,9 @@
 
 namespace ncfsim::fem {
 
+class CheckpointWriter;
+class CheckpointReader;
+
 enum class ToolShape { Plane, Sphere, Cylinder, Torus, PlaneWithHole, Triangles };
 
 /// Closest-point queries on triangles, bucketed on a uniform grid.
@@ -122,5 +125,11 @@ void tool_contact_forces(RigidTool& tool, const double* x, const double* v, cons
 /// left with no element by erosion); their friction state goes with them, the near list is
 /// rebuilt in the next contact pass.
 void remove_tool_contact_nodes(RigidTool& tool, const std::vector<std::uint8_t>& gone);
+
+/// The tool's state (motion, force, friction, contact nodes left after erosion, the proximity
+/// list, whose order fixes the order of the friction sums) into a checkpoint and back into a tool
+/// of the same case (CheckpointMismatch when it does not fit).
+void save_tool_state(const RigidTool& tool, CheckpointWriter& w);
+void load_tool_state(RigidTool& tool, CheckpointReader& r);
 
 }  // namespace ncfsim::fem

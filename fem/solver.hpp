@@ -23,6 +23,8 @@ struct PartMassReport {
 };
 
 class PictureFrameMotion;
+class CheckpointWriter;
+class CheckpointReader;
 
 /// The blocks of one kind among the solver's element groups, in group order (range-for, [], at).
 template <class Block>
@@ -120,6 +122,15 @@ class ExplicitSolver {
   double frame_wall_power(std::size_t k) const;
   /// Nodes in contact with the walls of picture frame k in the last cycle.
   std::int64_t frame_wall_contacts(std::size_t k) const;
+
+  /// The mutable state at a cycle boundary (between two step() calls): x^n, v^{n-1/2}, time and
+  /// steps, energies and pending works, erosion, then every group (/groups/NNN), tool
+  /// (/tools/<name>) and contact (/contacts/NNN) into the current group of `w`.
+  void save_state(CheckpointWriter& w) const;
+  /// Overwrites the state of a solver just built from the same case (before its first step(),
+  /// else std::logic_error) with a saved one; the next step() goes on as the saved run's would,
+  /// bit for bit. CheckpointMismatch names what does not fit (another mesh size, another group).
+  void load_state(CheckpointReader& r);
 
  private:
   void build_blocks();

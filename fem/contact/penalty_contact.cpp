@@ -6,6 +6,7 @@
 #include <limits>
 #include <numeric>
 
+#include "fem/checkpoint.hpp"
 #include "fem/contact/contact_force_kernel.hpp"
 #include "fem/errors.hpp"
 
@@ -561,6 +562,91 @@ std::vector<ContactResultant> PenaltyContact::resultants() const {
     out.push_back({a + "__" + b, pair_force_[p]});
   }
   return out;
+}
+
+void PenaltyContact::save_state(CheckpointWriter& w) const {
+  const std::size_t nf = facet_state_.size();
+  std::vector<double> tang(3 * nf), offset(nf), elastic(nf);
+  std::vector<std::int32_t> last(nf);
+  for (std::size_t k = 0; k < nf; ++k) {
+    const FacetState& f = facet_state_[k];
+    for (int c = 0; c < 3; ++c) tang[3 * k + static_cast<std::size_t>(c)] = f.tang[c];
+    offset[k] = f.offset, elastic[k] = f.elastic, last[k] = f.last;
+  }
+  save_array(w, "facet_tangential", tang);
+  save_array(w, "facet_offset", offset);
+  save_array(w, "facet_elastic", elastic);
+  save_array(w, "facet_last", last);
+  save_array(w, "facet_start", facet_start_);
+  save_array(w, "x_sorted", x_sorted_);
+  save_array(w, "seg_eroded", seg_eroded_);
+  save_array(w, "seg_dormant", seg_dormant_);
+  w.write_int("resort", resort_ ? 1 : 0);
+  w.write_double("dissipation", dissipation_);
+  std::vector<double> pf;
+  for (const V3& f : pair_force_) pf.insert(pf.end(), {f.x, f.y, f.z});
+  save_array(w, "pair_force", pf);
+  const std::vector<std::int64_t> counts = {stats_.n_cycles, stats_.n_sorts, stats_.n_candidates,
+                                            stats_.n_active, stats_.max_penetration_node};
+  const std::vector<double> values = {stats_.max_penetration, stats_.run_max_penetration,
+                                      stats_.sort_seconds, stats_.check_seconds,
+                                      stats_.narrow_seconds};
+  save_array(w, "stats_counts", counts);
+  save_array(w, "stats_values", values);
+}
+
+void PenaltyContact::load_state(CheckpointReader& r) {
+  const std::size_t n_node = surf_.n_nodes();
+  load_array(r, "seg_eroded", seg_eroded_);
+  load_array(r, "seg_dormant", seg_dormant_);
+  collect_active_segments();
+  box_lo_.resize(3 * active_seg_.size());
+  box_hi_.resize(3 * active_seg_.size());
+  // The sort at the saved positions of the surface nodes (every segment corner is one; no other
+  // position is read) rebuilds what the last sort made. With a sort pending (an erosion since
+  // then) the next cycle sorts again from the saved facet layout.
+  load_array(r, "x_sorted", x_sorted_);
+  {
+    std::vector<double> x(3 * node_mass_.size(), 0.0);
+    for (std::size_t e = 0; e < n_node; ++e)
+      for (std::size_t k = 0; k < 3; ++k)
+        x[3 * static_cast<std::size_t>(surf_.node[e]) + k] = x_sorted_[3 * e + k];
+    sort_segments(x.data());
+  }
+  const bool resort = r.read_int("resort") != 0;
+  std::vector<std::int32_t> start;
+  r.read_array("facet_start", start, n_node + 1);
+  if (!resort && start != facet_start_)
+    r.mismatch("facet_start", "the surface sorted at the saved positions has other node facets");
+  facet_start_ = start;
+  const auto nf = static_cast<std::size_t>(facet_start_[n_node]);
+  std::vector<double> tang, offset, elastic;
+  std::vector<std::int32_t> last;
+  r.read_array("facet_tangential", tang, 3 * nf);
+  r.read_array("facet_offset", offset, nf);
+  r.read_array("facet_elastic", elastic, nf);
+  r.read_array("facet_last", last, nf);
+  facet_state_.assign(nf, FacetState{});
+  for (std::size_t k = 0; k < nf; ++k) {
+    FacetState& f = facet_state_[k];
+    for (int c = 0; c < 3; ++c) f.tang[c] = tang[3 * k + static_cast<std::size_t>(c)];
+    f.offset = offset[k], f.elastic = elastic[k], f.last = last[k];
+  }
+  resort_ = resort;
+  dissipation_ = r.read_double("dissipation");
+  std::vector<double> pf;
+  r.read_array("pair_force", pf, 3 * pair_force_.size());
+  for (std::size_t k = 0; k < pair_force_.size(); ++k)
+    pair_force_[k] = {pf[3 * k], pf[3 * k + 1], pf[3 * k + 2]};
+  std::vector<std::int64_t> counts;
+  std::vector<double> values;
+  r.read_array("stats_counts", counts, 5);
+  r.read_array("stats_values", values, 5);
+  stats_.n_cycles = counts[0], stats_.n_sorts = counts[1], stats_.n_candidates = counts[2];
+  stats_.n_active = counts[3], stats_.max_penetration_node = static_cast<std::int32_t>(counts[4]);
+  stats_.max_penetration = values[0], stats_.run_max_penetration = values[1];
+  stats_.sort_seconds = values[2], stats_.check_seconds = values[3];
+  stats_.narrow_seconds = values[4];
 }
 
 }  // namespace ncfsim::fem

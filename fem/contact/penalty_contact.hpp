@@ -83,6 +83,11 @@ class PenaltyContact final : public ContactAlgorithm {
   /// Faces of eroded hexahedra leave the surface; the faces of their neighbours in the same group
   /// that they covered join it (set up when the solver erodes: ContactSetup::erosion).
   void erode(const std::vector<std::int32_t>& mesh_elements) override;
+  /// Saves the facets' friction state, the positions of the last sort and the segment flags;
+  /// load_state sorts again at the saved positions (the sort reads nothing else), which rebuilds
+  /// the candidates, frames and grid exactly, then overwrites the friction state.
+  void save_state(CheckpointWriter& w) const override;
+  void load_state(CheckpointReader& r) override;
 
   const PenaltyContactConfig& config() const { return cfg_; }
   const ContactSurface& surface() const { return surf_; }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fem/checkpoint.hpp"
 #include "fem/contact/bucket_grid.hpp"
 #include "fem/contact/contact_surface.hpp"
 #include "fem/contact/segment_frame.hpp"
@@ -411,6 +412,43 @@ std::vector<ContactResultant> TiedContact::resultants() const {
   const std::string a = cfg_.slave.name.empty() ? "slave" : cfg_.slave.name;
   const std::string b = cfg_.master.name.empty() ? "master" : cfg_.master.name;
   return {{a + "__" + b, force_}};
+}
+
+void TiedContact::save_state(CheckpointWriter& w) const {
+  w.write_int("n_ties", static_cast<std::int64_t>(node_.size()));
+  save_array(w, "alive", alive_);
+  std::vector<double> max_sep(state_.size()), damage(state_.size());
+  for (std::size_t t = 0; t < state_.size(); ++t)
+    max_sep[t] = state_[t].max_separation, damage[t] = state_[t].damage;
+  save_array(w, "max_separation", max_sep);
+  save_array(w, "damage", damage);
+  save_array(w, "tie_work", tie_work_);
+  save_array(w, "last_separation", last_sep_);
+  save_array(w, "last_force", last_force_);
+  w.write_double("failed_work", failed_work_);
+  w.write_int("n_alive", n_alive_);
+  w.write_double("dissipation", dissipation_);
+  const double f[3] = {force_.x, force_.y, force_.z};
+  w.write_array("force", std::span<const double>(f, 3));
+}
+
+void TiedContact::load_state(CheckpointReader& r) {
+  r.check_int("n_ties", static_cast<std::int64_t>(node_.size()));
+  load_array(r, "alive", alive_);
+  std::vector<double> max_sep, damage;
+  r.read_array("max_separation", max_sep, state_.size());
+  r.read_array("damage", damage, state_.size());
+  for (std::size_t t = 0; t < state_.size(); ++t)
+    state_[t].max_separation = max_sep[t], state_[t].damage = damage[t];
+  load_array(r, "tie_work", tie_work_);
+  load_array(r, "last_separation", last_sep_);
+  load_array(r, "last_force", last_force_);
+  failed_work_ = r.read_double("failed_work");
+  n_alive_ = r.read_int("n_alive");
+  dissipation_ = r.read_double("dissipation");
+  double f[3];
+  r.read_into("force", f, 3);
+  force_ = {f[0], f[1], f[2]};
 }
 
 }  // namespace ncfsim::fem

@@ -32,6 +32,8 @@ class TiedContact final : public ContactAlgorithm {
   std::int64_t active_contacts() const override { return n_alive_; }
   /// Ties on faces of eroded hexahedra fail in the next add_forces (their energy released).
   void erode(const std::vector<std::int32_t>& mesh_elements) override;
+  void save_state(CheckpointWriter& w) const override;
+  void load_state(CheckpointReader& r) override;
 
   const TiedContactConfig& config() const { return cfg_; }
   std::size_t n_ties() const { return node_.size(); }

@@ -1,6 +1,7 @@
 // The bar group: fem/elements/bar_block.hpp's kernels behind the ElementGroup interface.
 #include <cmath>
 
+#include "fem/checkpoint.hpp"
 #include "fem/elements/bar_block.hpp"
 #include "fem/elements/element_group.hpp"
 #include "fem/errors.hpp"
@@ -50,6 +51,14 @@ class BarGroup final : public ElementGroup {
   void cell_values(const double*, double* const* out) const override {
     for (std::size_t e = 0; e < block.n; ++e)
       out[0][e] = block.force[e], out[1][e] = block.strain[e];
+  }
+  void save_state(CheckpointWriter& w) const override {
+    save_array(w, "strain", block.strain);
+    save_array(w, "force", block.force);
+  }
+  void load_state(CheckpointReader& r) override {
+    load_array(r, "strain", block.strain);
+    load_array(r, "force", block.force);
   }
 };
 

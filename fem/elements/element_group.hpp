@@ -16,6 +16,8 @@ namespace ncfsim::fem {
 
 struct Model;
 struct ElementSet;
+class CheckpointWriter;
+class CheckpointReader;
 
 /// Nodal state an element kernel reads in a cycle, [3*n_nodes] each.
 struct ElementCycleState {
@@ -84,6 +86,12 @@ class ElementGroup {
   /// out[k] points to [size()][components of field k] of cell_fields()[k].
   virtual std::vector<CellFieldSpec> cell_fields() const = 0;
   virtual void cell_values(const double* x, double* const* out) const = 0;
+
+  /// The group's mutable state (its block's state arrays, and what the group itself carries from
+  /// cycle to cycle) into a checkpoint, and back into a group built from the same case
+  /// (fem/checkpoint.hpp: "rebuild, then overwrite"; CheckpointMismatch on another size).
+  virtual void save_state(CheckpointWriter& w) const = 0;
+  virtual void load_state(CheckpointReader& r) = 0;
 
  protected:
   // Set by the group from its block's arrays (the block owns them).

@@ -1,6 +1,7 @@
 // The hexahedron group: fem/elements/hex8_block.hpp's kernels behind the ElementGroup interface.
 #include <cmath>
 
+#include "fem/checkpoint.hpp"
 #include "fem/elements/element_fields.hpp"
 #include "fem/elements/element_group.hpp"
 #include "fem/elements/hex8_block.hpp"
@@ -64,6 +65,29 @@ class Hex8Group final : public ElementGroup {
   void cell_values(const double* x, double* const* out) const override {
     hex8_output_fields(block, x, out[0], out[1], out[2]);
     for (std::size_t e = 0; e < block.n; ++e) out[3][e] = block.n_eroded ? block.eroded[e] : 0.0;
+  }
+  void save_state(CheckpointWriter& w) const override {
+    save_array(w, "stress", block.stress);
+    save_array(w, "strain", block.strain);
+    save_array(w, "history", block.history);
+    save_array(w, "hg_force", block.hg_force);
+    save_array(w, "hg_viscous", block.hg_viscous);
+    save_array(w, "volume", block.volume);
+    save_array(w, "eroded", block.eroded);  // empty: none eroded yet
+  }
+  void load_state(CheckpointReader& r) override {
+    load_array(r, "stress", block.stress);
+    load_array(r, "strain", block.strain);
+    load_array(r, "history", block.history);
+    load_array(r, "hg_force", block.hg_force);
+    load_array(r, "hg_viscous", block.hg_viscous);
+    load_array(r, "volume", block.volume);
+    r.read_array("eroded", block.eroded);
+    if (!block.eroded.empty() && block.eroded.size() != block.n)
+      r.mismatch("eroded", "has " + std::to_string(block.eroded.size()) +
+                               " values, this model needs " + std::to_string(block.n));
+    block.n_eroded = 0;
+    for (auto e : block.eroded) block.n_eroded += e ? 1 : 0;
   }
 };
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "fem/checkpoint.hpp"
 #include "fem/elements/element_group.hpp"
 #include "fem/elements/shell4_block.hpp"
 #include "fem/errors.hpp"
@@ -99,6 +100,39 @@ class Shell4Group final : public ElementGroup {
   }
 
   const std::vector<double>& rotation_velocity() const { return omega_; }
+
+  void save_state(CheckpointWriter& w) const override {
+    save_array(w, "strain", block.strain);
+    save_array(w, "curvature", block.curvature);
+    save_array(w, "shear", block.shear);
+    save_array(w, "resultant", block.resultant);
+    save_array(w, "moment", block.moment);
+    save_array(w, "shear_force", block.shear_force);
+    save_array(w, "hg_force", block.hg_force);
+    save_array(w, "drill_moment", block.drill_moment);
+    save_array(w, "polar_angle", block.polar_angle);
+    save_array(w, "history", block.history);
+    save_array(w, "rotation_velocity", omega_);
+    save_array(w, "nodal_moment", moment_);
+    w.write_double("dt_last", dt_last_);
+    w.write_double("rotational_kinetic", ke_rot_);
+  }
+  void load_state(CheckpointReader& r) override {
+    load_array(r, "strain", block.strain);
+    load_array(r, "curvature", block.curvature);
+    load_array(r, "shear", block.shear);
+    load_array(r, "resultant", block.resultant);
+    load_array(r, "moment", block.moment);
+    load_array(r, "shear_force", block.shear_force);
+    load_array(r, "hg_force", block.hg_force);
+    load_array(r, "drill_moment", block.drill_moment);
+    load_array(r, "polar_angle", block.polar_angle);
+    load_array(r, "history", block.history);
+    load_array(r, "rotation_velocity", omega_);
+    load_array(r, "nodal_moment", moment_);
+    dt_last_ = r.read_double("dt_last");
+    ke_rot_ = r.read_double("rotational_kinetic");
+  }
 
  private:
   std::vector<double> omega_, moment_, inertia_;  // [3 n], [3 n], [n] over all mesh nodes
