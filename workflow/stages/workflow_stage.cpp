@@ -355,7 +355,7 @@ std::string number(const json& s, const std::string& key, const char* fmt_spec =
 }
 
 // The shear rings of every stage that measured one, on one plot (the meso drape's own column
-// shear_deg, a kinematic drape's kinematic_shear_deg).
+// shear_deg, a macro drape's macro_shear_deg, a kinematic drape's kinematic_shear_deg).
 bool ring_plot(const fs::path& dir, const json& stages, std::string& why) {
   render::CurvePlot plot;
   plot.title = "Shear angle round the ring";
@@ -368,9 +368,15 @@ bool ring_plot(const fs::path& dir, const json& stages, std::string& why) {
       const CsvTable t = read_csv(csv);
       const auto az = t.column("azimuth_deg");
       const bool kinematic = e["kind"] == "kinematic_drape";
-      const auto y = t.column(kinematic ? "kinematic_shear_deg" : "shear_deg");
+      const bool macro =
+          std::find(t.columns.begin(), t.columns.end(), "macro_shear_deg") != t.columns.end();
+      const auto y = t.column(kinematic ? "kinematic_shear_deg"
+                              : macro   ? "macro_shear_deg"
+                                        : "shear_deg");
       render::CurveSeries s;
-      s.label = e["name"].get<std::string>() + (kinematic ? " (pin-jointed net)" : "");
+      s.label = e["name"].get<std::string>() + (kinematic ? " (pin-jointed net)"
+                                                : macro   ? " (macro shells)"
+                                                          : "");
       s.dashed = kinematic;
       for (std::size_t i = 0; i < az.size(); ++i)
         if (std::isfinite(y[i])) s.x.push_back(az[i]), s.y.push_back(y[i]);
@@ -434,9 +440,14 @@ void drapes_section(std::ostream& h, const fs::path& dir, const json& stages,
   for (const auto& e : stages) {
     const std::string nm = e["name"].get<std::string>();
     const json& ss = sums.at(nm);
-    for (const char* prefix : {"", "kinematic_"}) {
+    for (const char* prefix : {"", "macro_", "kinematic_"}) {
       if (!ss.is_object() || !ss.contains(std::string(prefix) + "max_shear_deg_q1")) continue;
-      q << "<tr><td>" << escape(nm) << (*prefix ? " (pin-jointed net)" : "") << "</td>";
+      const std::string pre = prefix;
+      q << "<tr><td>" << escape(nm)
+        << (pre == "kinematic_" ? " (pin-jointed net)"
+            : pre == "macro_"   ? " (macro shells)"
+                                : "")
+        << "</td>";
       for (int k = 1; k <= 4; ++k)
         q << "<td>" << number(ss, fmt::format("{}max_shear_deg_q{}", prefix, k), "{:.1f}")
           << "</td>";
