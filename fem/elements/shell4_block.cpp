@@ -263,11 +263,25 @@ inline void gather_lanes(const Shell4Block& b, std::size_t e0, int cnt, const do
                          VD p[4][3]) {
   for (std::size_t I = 0; I < 4; ++I) {
     const std::int32_t* c = b.conn.data() + I * b.n + e0;
+    alignas(64) std::size_t base[W];
+    for (int l = 0; l < W; ++l) base[l] = 3 * static_cast<std::size_t>(c[l < cnt ? l : cnt - 1]);
     for (std::size_t k = 0; k < 3; ++k)
-      p[I][k] = VD([&](auto l) {
-        const int j = static_cast<int>(l) < cnt ? static_cast<int>(l) : cnt - 1;
-        return x[3 * static_cast<std::size_t>(c[j]) + k];
-      });
+      p[I][k] = VD([&](auto l) { return x[base[static_cast<int>(l)] + k]; });
+  }
+}
+
+// The same for three nodal arrays at once (positions, velocities, rotation velocities).
+inline void gather_lanes3(const Shell4Block& b, std::size_t e0, int cnt, const double* x,
+                          const double* v, const double* w, VD p[4][3], VD vv[4][3], VD ww[4][3]) {
+  for (std::size_t I = 0; I < 4; ++I) {
+    const std::int32_t* c = b.conn.data() + I * b.n + e0;
+    alignas(64) std::size_t base[W];
+    for (int l = 0; l < W; ++l) base[l] = 3 * static_cast<std::size_t>(c[l < cnt ? l : cnt - 1]);
+    for (std::size_t k = 0; k < 3; ++k) {
+      p[I][k] = VD([&](auto l) { return x[base[static_cast<int>(l)] + k]; });
+      vv[I][k] = VD([&](auto l) { return v[base[static_cast<int>(l)] + k]; });
+      ww[I][k] = VD([&](auto l) { return w[base[static_cast<int>(l)] + k]; });
+    }
   }
 }
 
@@ -388,9 +402,7 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
       const std::size_t e0 = c0 + j0;
       const int cnt = static_cast<int>(std::min<std::size_t>(W, m - j0));
       VD p[4][3], vv[4][3], ww[4][3];
-      gather_lanes(b, e0, cnt, x, p);
-      gather_lanes(b, e0, cnt, v, vv);
-      gather_lanes(b, e0, cnt, w, ww);
+      gather_lanes3(b, e0, cnt, x, v, w, p, vv, ww);
       FrameLanes f;
       frame_lanes(p, f);
       const VD A = f.area;
@@ -422,9 +434,14 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
       VD cm = (c + co) / rm, sm = (s + so) / rm;
       stdx::where(small, cm) = c;
       stdx::where(small, sm) = s;
-      for (int l = 0; l < cnt; ++l) {
-        b.polar_angle[2 * (e0 + static_cast<std::size_t>(l))] = c[l];
-        b.polar_angle[2 * (e0 + static_cast<std::size_t>(l)) + 1] = s[l];
+      {
+        alignas(64) double cb[W], sb[W];
+        c.copy_to(cb, stdx::vector_aligned);
+        s.copy_to(sb, stdx::vector_aligned);
+        for (int l = 0; l < cnt; ++l) {
+          b.polar_angle[2 * (e0 + static_cast<std::size_t>(l))] = cb[l];
+          b.polar_angle[2 * (e0 + static_cast<std::size_t>(l)) + 1] = sb[l];
+        }
       }
 
       // Rates over the step (current frame), hourglass vectors, in-plane spin.
@@ -554,7 +571,7 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
       const VD Qc[2] = {c * Qr[0] - s * Qr[1], s * Qr[0] + c * Qr[1]};
       const VD Hc[5] = {c * Qh[0] - s * Qh[1], s * Qh[0] + c * Qh[1], Qh[2], c * Qh[3] - s * Qh[4],
                         s * Qh[3] + c * Qh[4]};
-      VD fg[4][3], mg[4][3];
+      alignas(64) double fg[4][6][W];  // per node: force xyz, moment xyz; lanes last
       for (int I = 0; I < 4; ++I) {
         const VD b1 = f.B[0][I], b2 = f.B[1][I], g = gam[I];
         const VD fl0 = A * (b1 * Ncur[0] + b2 * Ncur[2]) + g * Hc[0] + 0.5 * b2 * Msum;
@@ -563,8 +580,10 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
         const VD ml0 = A * (-b2 * Mc[1] - b1 * Mc[2] - 0.25 * Qc[1]) + g * Hc[3];
         const VD ml1 = A * (b1 * Mc[0] + b2 * Mc[2] + 0.25 * Qc[0]) + g * Hc[4];
         for (int k = 0; k < 3; ++k) {
-          fg[I][k] = fl0 * f.e[0][k] + fl1 * f.e[1][k] + fl2 * f.e[2][k];
-          mg[I][k] = ml0 * f.e[0][k] + ml1 * f.e[1][k] + Md[I] * f.e[2][k];
+          (fl0 * f.e[0][k] + fl1 * f.e[1][k] + fl2 * f.e[2][k])
+              .copy_to(fg[I][k], stdx::vector_aligned);
+          (ml0 * f.e[0][k] + ml1 * f.e[1][k] + Md[I] * f.e[2][k])
+              .copy_to(fg[I][3 + k], stdx::vector_aligned);
         }
       }
       // Stable step at the current shape (squared lengths: two roots per element).
@@ -578,16 +597,18 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
       const VD ms = batch::load(b.mass_scale.data() + e0, cnt);
       VD dte = stdx::sqrt(stdx::min(l2min, A * A / l2max) * ms) * slowness;
       stdx::where(!f.ok, dte) = 0.0;
+      alignas(64) double dtb[W];
+      dte.copy_to(dtb, stdx::vector_aligned);
       // Scatter, lane by lane (nodes are shared between lanes).
       for (int l = 0; l < cnt; ++l) {
         const std::size_t e = e0 + static_cast<std::size_t>(l);
-        if (dte[l] < step.dt) step = {dte[l], b.user_id[e], ElementKind::Quad4};
-        if (!f.ok[l]) continue;
+        if (dtb[l] < step.dt) step = {dtb[l], b.user_id[e], ElementKind::Quad4};
+        if (!(dtb[l] > 0)) continue;  // a degenerate shell: no force (the solver stops on its step)
         for (std::size_t I = 0; I < 4; ++I) {
           const auto node = static_cast<std::size_t>(b.conn[I * n + e]);
           double* fi = fo + 3 * node;
           double* mi = mo + 3 * node;
-          for (int k = 0; k < 3; ++k) fi[k] -= fg[I][k][l], mi[k] -= mg[I][k][l];
+          for (int k = 0; k < 3; ++k) fi[k] -= fg[I][k][l], mi[k] -= fg[I][3 + k][l];
         }
       }
     }
