@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "fem/checkpoint.hpp"
 #include "fem/solver.hpp"
 #include "fem/vec3.hpp"
 
@@ -82,6 +83,10 @@ class RunMeasure {
     (void)s, (void)dir;
     return {};
   }
+  /// What the measure carries from one row to the next (most carry nothing), into a checkpoint
+  /// and back into the same measure of a rebuilt run (fem/checkpoint.hpp).
+  virtual void save_state(CheckpointWriter& w) const { (void)w; }
+  virtual void load_state(CheckpointReader& r) { (void)r; }
 };
 
 /// Mean displacement of a set of nodes at the solver's current state (m).

@@ -33,6 +33,17 @@ class CrushMeasure final : public fem::RunMeasure {
 
   /// Column of the filtered punch force: <punch>_force_cfc<class>_N.
   std::string filtered_column() const;
+  /// The force-stroke samples so far (a resumed run's filter sees the whole curve).
+  void save_state(fem::CheckpointWriter& w) const override {
+    fem::save_array(w, "time", time_);
+    fem::save_array(w, "stroke", stroke_);
+    fem::save_array(w, "force", force_);
+  }
+  void load_state(fem::CheckpointReader& r) override {
+    r.read_array("time", time_);
+    r.read_array("stroke", stroke_, time_.size());
+    r.read_array("force", force_, time_.size());
+  }
 
  private:
   struct DamageCounts {

@@ -81,6 +81,10 @@ int main(int argc, char** argv) {
                 "same names are replaced, nothing else is touched)");
   run->add_option("--force", force_stages,
                   "Workflow: rerun this stage although its inputs have not changed (repeatable)");
+  bool resume = false;
+  run->add_flag("--resume", resume,
+                "Continue an interrupted run in its output folder from its checkpoint.h5 (the "
+                "same case and --set; time.max_cycles may differ)");
   run->add_option("--progress-interval", progress, "Seconds between progress lines (default 5)")
       ->check(CLI::Validator(
           [](const std::string& s) {
@@ -281,6 +285,7 @@ int main(int argc, char** argv) {
       call.options.progress_interval_s = progress;
       call.options.force_stages = force_stages;
       call.options.overwrite = overwrite;
+      call.options.resume = resume;
       return wf::run_stage(call);
     }
     if (*compare) {

@@ -20,6 +20,16 @@ class FabricReport final : public fem::RunMeasure {
   std::vector<std::string> setup_lines() const override;
   std::vector<std::string> after_erosion(const fem::ExplicitSolver& s) override;
   void add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const override;
+  /// The released joints already warned about (a resumed run does not warn again).
+  void save_state(fem::CheckpointWriter& w) const override {
+    std::vector<std::int64_t> v(released_logged_.begin(), released_logged_.end());
+    fem::save_array(w, "released_logged", v);
+  }
+  void load_state(fem::CheckpointReader& r) override {
+    std::vector<std::int64_t> v;
+    r.read_array("released_logged", v);
+    released_logged_.assign(v.begin(), v.end());
+  }
 
  private:
   std::size_t released(std::size_t k) const { return joints_[k] ? joints_[k]->released() : 0; }

@@ -176,6 +176,10 @@ class VtuSeriesWriter {
   const std::filesystem::path& pvd_path() const;
   /// Path of the .vtu of frame `index` (0-based), whether or not it has been written yet.
   std::filesystem::path frame_path(std::size_t index) const;
+  /// Takes over the frames 0..times.size()-1 an earlier writer wrote into this folder (a resumed
+  /// run): results.pvd lists them again at these times, later frames' files are removed, and
+  /// write_frame goes on after them. Throws std::runtime_error naming a kept frame's missing file.
+  void keep_frames(const std::vector<double>& times);
 
  private:
   struct Impl;

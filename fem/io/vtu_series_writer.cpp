@@ -214,6 +214,23 @@ void VtuSeriesWriter::close() {
   if (impl_) impl_->closed = true;
 }
 
+void VtuSeriesWriter::keep_frames(const std::vector<double>& times) {
+  if (!impl_) throw std::logic_error("VtuSeriesWriter: keep_frames on a moved-from writer");
+  impl_->entries.clear();
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    const std::string name = impl_->frame_name(k);
+    if (!std::filesystem::is_regular_file(impl_->frames_dir / name))
+      throw std::runtime_error("frame file '" + (impl_->frames_dir / name).string() +
+                               "' of the resumed run is missing");
+    impl_->entries.push_back({times[k], std::string(kFramesDir) + "/" + name});
+  }
+  for (std::size_t k = times.size();; ++k) {
+    std::error_code ec;
+    if (!std::filesystem::remove(impl_->frames_dir / impl_->frame_name(k), ec)) break;
+  }
+  detail::atomic_write_text(impl_->pvd, impl_->pvd_text());
+}
+
 std::size_t VtuSeriesWriter::frames_written() const { return impl_ ? impl_->entries.size() : 0; }
 const std::filesystem::path& VtuSeriesWriter::pvd_path() const { return impl_->pvd; }
 std::filesystem::path VtuSeriesWriter::frame_path(std::size_t index) const {

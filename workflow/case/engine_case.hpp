@@ -68,6 +68,10 @@ struct OutputSettings {
   bool vtu = false;     // frames/*.vtu + results.pvd
   bool figures = true;  // render figures at the end of the run
   bool report = false;  // write report.html at the end of the run
+  // checkpoint.h5 (issue #22): every checkpoint_interval wall minutes (0: only at a stop), and
+  // every checkpoint_every_cycles cycles (0: off; for tests: a checkpoint at a known cycle).
+  double checkpoint_interval_min = 10.0;
+  std::int64_t checkpoint_every_cycles = 0;
 };
 
 /// A curve plot from history.csv: y columns against an x column.

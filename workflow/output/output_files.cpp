@@ -15,7 +15,8 @@
 
 namespace ncfsim::workflow {
 
-std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out_dir, Verbosity v) {
+std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out_dir, Verbosity v,
+                                                bool append) {
   auto console = std::make_shared<spdlog::sinks::stdout_color_sink_mt>();
   console->set_pattern("%v");
   console->set_level(v == Verbosity::Quiet     ? spdlog::level::warn
@@ -24,13 +25,13 @@ std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out
   std::vector<spdlog::sink_ptr> sinks{console};
   if (!out_dir.empty()) {
     auto file =
-        std::make_shared<spdlog::sinks::basic_file_sink_mt>((out_dir / "log.txt").string(), true);
+        std::make_shared<spdlog::sinks::basic_file_sink_mt>((out_dir / "log.txt").string(), !append);
     file->set_pattern("[%Y-%m-%d %H:%M:%S] %v");
     file->set_level(v == Verbosity::Verbose ? spdlog::level::debug : spdlog::level::info);
     sinks.push_back(file);
     // The warnings alone, for the workflow's report (one list over every stage).
     auto warnings = std::make_shared<spdlog::sinks::basic_file_sink_mt>(
-        (out_dir / "warnings.txt").string(), true);
+        (out_dir / "warnings.txt").string(), !append);
     warnings->set_pattern("%v");
     warnings->set_level(spdlog::level::warn);
     sinks.push_back(warnings);
@@ -66,9 +67,11 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
   fem::io::atomic_write_text(path, text);
 }
 
-HistoryWriter::HistoryWriter(const std::filesystem::path& file, std::vector<std::string> columns)
-    : out_(file), columns_(std::move(columns)) {
+HistoryWriter::HistoryWriter(const std::filesystem::path& file, std::vector<std::string> columns,
+                             bool append)
+    : out_(file, append ? std::ios::app : std::ios::out), columns_(std::move(columns)) {
   if (!out_) throw std::runtime_error("cannot write " + file.string());
+  if (append) return;
   for (std::size_t i = 0; i < columns_.size(); ++i) out_ << (i ? "," : "") << columns_[i];
   out_ << '\n';
   out_.flush();
@@ -197,6 +200,29 @@ OutputFolder OutputFolder::claim(const std::filesystem::path& dir, bool overwrit
   const nlohmann::json m = {
       {"complete", false}, {"before_files", o.before_files_}, {"before_dirs", o.before_dirs_}};
   write_file_atomically(manifest, m.dump(1) + "\n");
+  return o;
+}
+
+OutputFolder OutputFolder::resume(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  const fs::path manifest = dir / kManifest;
+  const nlohmann::json m = read_json_file(manifest);
+  if (!m.is_object())
+    throw InputError(dir.string(), "--resume",
+                     "is not an output folder of ncfsim (no readable " + std::string(kManifest) +
+                         ")");
+  OutputFolder o;
+  o.dir_ = dir;
+  o.before_files_ = m.value("before_files", std::vector<std::string>{});
+  o.before_dirs_ = m.value("before_dirs", std::vector<std::string>{});
+  std::sort(o.before_files_.begin(), o.before_files_.end());
+  std::sort(o.before_dirs_.begin(), o.before_dirs_.end());
+  o.start_ = fs::file_time_type::clock::now();
+  std::error_code ec;
+  fs::remove(dir / "checkpoint.h5.tmp", ec);  // left by a run killed while it wrote one
+  const nlohmann::json incomplete = {
+      {"complete", false}, {"before_files", o.before_files_}, {"before_dirs", o.before_dirs_}};
+  write_file_atomically(manifest, incomplete.dump(1) + "\n");
   return o;
 }
 

@@ -17,7 +17,9 @@ namespace ncfsim::workflow {
 enum class Verbosity { Quiet, Normal, Verbose };
 
 /// Console + log.txt logger; the same lines go to both (the console honours the verbosity).
-std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out_dir, Verbosity v);
+/// `append`: log.txt and warnings.txt are continued (a resumed run), not truncated.
+std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out_dir, Verbosity v,
+                                                bool append = false);
 
 /// The whole file as bytes; empty when it cannot be read.
 std::string read_file(const std::filesystem::path& path);
@@ -42,6 +44,10 @@ class OutputFolder {
   /// entries named in `keep` (a workflow's stage folders) are neither removed nor counted.
   static OutputFolder claim(const std::filesystem::path& dir, bool overwrite,
                             const std::vector<std::string>& keep = {});
+  /// Takes over the folder of an interrupted run to continue it (`--resume`): its files stay,
+  /// the files that were there before that run stay the user's; the manifest is marked
+  /// incomplete until finish(). InputError when the folder holds no manifest of ncfsim.
+  static OutputFolder resume(const std::filesystem::path& dir);
   /// Rewrites the manifest with every file and folder written since claim().
   void finish() const;
   /// Adds files written into a finished run's folder later (`ncfsim render`, `report`,
@@ -60,7 +66,9 @@ class OutputFolder {
 /// Each row is flushed, so an interrupted run leaves only complete rows.
 class HistoryWriter {
  public:
-  HistoryWriter(const std::filesystem::path& file, std::vector<std::string> columns);
+  /// `append`: continues an existing file (a resumed run) without writing the header.
+  HistoryWriter(const std::filesystem::path& file, std::vector<std::string> columns,
+                bool append = false);
   void write_row(const std::vector<double>& values);
   const std::vector<std::string>& columns() const { return columns_; }
 

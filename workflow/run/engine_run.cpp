@@ -8,16 +8,21 @@
 #include <spdlog/logger.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
 
+#include "fem/checkpoint.hpp"
 #include "fem/errors.hpp"
+#include "fem/io/hdf5_checkpoint.hpp"
+#include "fem/io/result_reader.hpp"
 #include "fem/io/result_writers.hpp"
 #include "fem/solver.hpp"
 #include "workflow/figures/figures.hpp"
 #include "workflow/report/report.hpp"
 #include "workflow/run/result_mesh.hpp"
+#include "workflow/run/run_checkpoint.hpp"
 #include "workflow/run/run_history.hpp"
 #include "workflow/run/run_measures.hpp"
 #include "workflow/run/run_summary.hpp"
@@ -37,12 +42,90 @@ double seconds_since(Clock::time_point t0) {
 // results.h5/.xdmf and .vtu frames; a frame that cannot be written is logged, the run goes on.
 class FrameOutput {
  public:
+  /// New files, or with `resume` none yet: load_state() takes over those of the run it resumes.
   FrameOutput(const std::filesystem::path& dir, const OutputSettings& o,
-              const fem::ExplicitSolver& s) {
-    if (!o.xdmf && !o.vtu) return;
+              const fem::ExplicitSolver& s, bool resume = false)
+      : dir_(dir), settings_(o) {
+    if ((!o.xdmf && !o.vtu) || resume) return;
     const fem::io::ResultMesh mesh = result_mesh(s);
     if (o.xdmf) xdmf_ = std::make_unique<fem::io::XdmfResultWriter>(dir, mesh);
     if (o.vtu) vtu_ = std::make_unique<fem::io::VtuSeriesWriter>(dir, mesh);
+  }
+  void save_state(fem::CheckpointWriter& w) const {
+    w.write_int("frames_written", static_cast<std::int64_t>(written_));
+    w.write_int("frame_errors", static_cast<std::int64_t>(errors_));
+    fem::save_array(w, "frame_time", times_);
+    fem::save_array(w, "frame_cycle", cycles_);
+  }
+  /// The frames written up to the checkpoint are kept (results.h5 is written again with them:
+  /// frames written after the checkpoint go), .vtu frames after them are removed.
+  void load_state(fem::CheckpointReader& r, const fem::ExplicitSolver& s,
+                  const MeasureList& measures) {
+    written_ = static_cast<std::size_t>(r.read_int("frames_written"));
+    errors_ = static_cast<std::size_t>(r.read_int("frame_errors"));
+    r.read_array("frame_time", times_, written_);
+    r.read_array("frame_cycle", cycles_, written_);
+    if (!settings_.xdmf && !settings_.vtu) return;
+    const fem::io::ResultMesh mesh = result_mesh(s);
+    namespace fs = std::filesystem;
+    if (settings_.xdmf) {
+      const fs::path h5 = dir_ / "results.h5", old = dir_ / "results.h5.resume";
+      std::error_code ec;
+      if (fs::exists(h5, ec)) fs::rename(h5, old);
+      if (written_ > 0 && !fs::exists(old, ec))
+        throw InputError(h5.string(), "--resume",
+                         "is missing: the frames before the checkpoint are gone");
+      xdmf_ = std::make_unique<fem::io::XdmfResultWriter>(dir_, mesh);
+      // The fields in the order the run writes them (results.xdmf comes out the same).
+      std::vector<std::string> order;
+      {
+        const fem::io::Frame f0 = make_frame(s);
+        for (const auto& f : f0.fields) order.push_back(f.name);
+        std::vector<fem::MeasureCellField> extra;
+        for (const auto& m : measures) m->add_frame_fields(s, extra);
+        for (const auto& f : extra) order.push_back(f.name);
+      }
+      const auto rank = [&](const std::string& name) {
+        return std::find(order.begin(), order.end(), name) - order.begin();
+      };
+      if (written_ > 0) {
+        try {
+          const fem::io::ResultReader in(old);
+          if (in.n_frames() < written_)
+            throw std::runtime_error("holds " + std::to_string(in.n_frames()) + " frames, the " +
+                                     "checkpoint " + std::to_string(written_));
+          for (std::size_t k = 0; k < written_; ++k) {
+            fem::io::StoredFrame sf = in.frame(k);
+            fem::io::Frame fr;
+            fr.time = sf.time;
+            fr.cycle = sf.cycle;
+            for (auto& f : sf.fields) {
+              if (!f.on_cells && f.name == "displacement")
+                fr.displacement = std::move(f.values);
+              else
+                fr.fields.push_back(std::move(f));
+            }
+            std::stable_sort(fr.fields.begin(), fr.fields.end(), [&](const auto& a, const auto& b) {
+              return rank(a.name) < rank(b.name);
+            });
+            xdmf_->write_frame(fr);
+          }
+        } catch (const std::runtime_error& e) {
+          throw InputError(h5.string(), "--resume",
+                           std::string("the frames before the checkpoint cannot be read back (") +
+                               e.what() + ")");
+        }
+      }
+      fs::remove(old, ec);
+    }
+    if (settings_.vtu) {
+      vtu_ = std::make_unique<fem::io::VtuSeriesWriter>(dir_, mesh);
+      try {
+        vtu_->keep_frames(times_);
+      } catch (const std::runtime_error& e) {
+        throw InputError((dir_ / "results.pvd").string(), "--resume", e.what());
+      }
+    }
   }
   void write(const fem::ExplicitSolver& s, const MeasureList& measures, spdlog::logger& log) {
     if (!xdmf_ && !vtu_) return;
@@ -55,6 +138,8 @@ class FrameOutput {
       if (xdmf_) xdmf_->write_frame(fr);
       if (vtu_) vtu_->write_frame(fr);
       ++written_;
+      times_.push_back(fr.time);
+      cycles_.push_back(fr.cycle);
     } catch (const std::runtime_error& e) {
       ++errors_;
       log.error("frame at t = {:.6g} s not written: {}", s.time(), e.what());
@@ -68,9 +153,13 @@ class FrameOutput {
   std::size_t errors() const { return errors_; }
 
  private:
+  std::filesystem::path dir_;
+  OutputSettings settings_;
   std::unique_ptr<fem::io::XdmfResultWriter> xdmf_;
   std::unique_ptr<fem::io::VtuSeriesWriter> vtu_;
   std::size_t written_ = 0, errors_ = 0;
+  std::vector<double> times_;         // of the frames written
+  std::vector<std::int64_t> cycles_;  // of the frames written
 };
 
 // What the loop and the summary share while a case runs.
@@ -104,6 +193,20 @@ struct Run {
   double ke_ie_max =
       0;  // kinetic / internal energy at the history rows from time.quasi_static_from
   bool ke_ie_exceeded = false;
+
+  // The time loop's own state (saved in a checkpoint).
+  struct LoopState {
+    double next_history = 0, next_frame = 0;
+    bool exceeded_reported = false;
+    std::size_t erosions_logged = 0;
+  } loop;
+  // Checkpoints (issue #22).
+  std::string case_hash;               // checkpoint_case_hash of the case and overrides
+  double wall_before = 0;              // wall seconds of the segments before this one
+  std::int64_t segments = 1;           // this run's segment (1 + the resumes)
+  Clock::time_point last_checkpoint;   // wall time of the last checkpoint (or the start)
+  std::int64_t checkpoint_cycle = -1;  // cycle of the last checkpoint written or loaded
+  double wall_seconds() const { return wall_before + seconds_since(wall0); }
 
   void write_summary() const {
     write_file_atomically(dir / "summary.json", summary.dump(2) + "\n");
@@ -142,7 +245,7 @@ std::unique_ptr<fem::ExplicitSolver> make_solver(EngineCase& ec, Run& r) {
 void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measures,
                   const RunHistory& history, const FrameOutput& frames) {
   r.summary["status"] = r.status;
-  r.summary["wall_seconds"] = seconds_since(r.wall0);
+  r.summary["wall_seconds"] = r.wall_seconds();
   r.summary["peak_memory_MB"] = peak_memory_mb();
   r.summary["frames"] = frames.written();
   r.summary["frame_write_errors"] = frames.errors();
@@ -155,6 +258,107 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
   for (const auto& m : measures) m->add_summary(s, r.summary);
   add_history_summary(r.ec, history, r.summary);
   if (!r.failure.empty()) r.summary["error"] = r.failure;
+}
+
+// checkpoint.h5 at a cycle boundary (the top of the time loop): the whole state, atomically.
+// A checkpoint that cannot be written is logged; the run goes on.
+void write_checkpoint(Run& r, const fem::ExplicitSolver& s, const MeasureList& measures,
+                      const RunHistory& history, const FrameOutput& frames) {
+  if (r.checkpoint_cycle == s.cycle()) return;
+  const auto t0 = Clock::now();
+  const std::filesystem::path file = r.dir / kCheckpointFile;
+  try {
+    fem::CheckpointTree t;
+    write_checkpoint_header(t, r.ec, r.options, r.case_hash, s.time(), s.cycle(), r.wall_seconds(),
+                            r.segments);
+    s.save_state(t);
+    {
+      fem::CheckpointScope<fem::CheckpointWriter> ms(t, "measures");
+      t.write_int("count", static_cast<std::int64_t>(measures.size()));
+      for (std::size_t k = 0; k < measures.size(); ++k) {
+        fem::CheckpointScope<fem::CheckpointWriter> m(t, fem::checkpoint_index(k));
+        measures[k]->save_state(t);
+      }
+    }
+    {
+      fem::CheckpointScope<fem::CheckpointWriter> run(t, "run");
+      t.write_double("next_history", r.loop.next_history);
+      t.write_double("next_frame", r.loop.next_frame);
+      t.write_int("exceeded_reported", r.loop.exceeded_reported ? 1 : 0);
+      t.write_int("erosions_logged", static_cast<std::int64_t>(r.loop.erosions_logged));
+      std::vector<std::int64_t> decades;
+      std::vector<double> errors;
+      for (const auto& [d, e] : r.max_error_by_decade) decades.push_back(d), errors.push_back(e);
+      fem::save_array(t, "max_error_decades", decades);
+      fem::save_array(t, "max_error_values", errors);
+      t.write_double("ke_ie_max", r.ke_ie_max);
+      t.write_int("ke_ie_exceeded", r.ke_ie_exceeded ? 1 : 0);
+      history.save_state(t);
+      frames.save_state(t);
+      t.write_string("summary", r.summary.dump());
+    }
+    fem::io::write_checkpoint_file(file, t);
+    r.checkpoint_cycle = s.cycle();
+    std::error_code ec;
+    const auto bytes = std::filesystem::file_size(file, ec);
+    r.log->info("checkpoint at t = {:.6g} s, cycle {} ({:.1f} MB, {:.2f} s)", s.time(), s.cycle(),
+                ec ? 0.0 : static_cast<double>(bytes) / 1e6, seconds_since(t0));
+  } catch (const std::exception& e) {
+    r.log->error("checkpoint at t = {:.6g} s not written: {}", s.time(), e.what());
+  }
+  r.last_checkpoint = Clock::now();
+}
+
+// Overwrites the state of the run just built from the same case with the checkpoint's.
+void load_checkpoint(Run& r, fem::CheckpointTree& t, fem::ExplicitSolver& s, MeasureList& measures,
+                     RunHistory& history, FrameOutput& frames) {
+  const double wall = t.read_double("wall_seconds");
+  const std::int64_t segments = t.read_int("segments");
+  try {
+    s.load_state(t);
+    {
+      fem::CheckpointScope<fem::CheckpointReader> ms(t, "measures");
+      t.check_int("count", static_cast<std::int64_t>(measures.size()));
+      for (std::size_t k = 0; k < measures.size(); ++k) {
+        fem::CheckpointScope<fem::CheckpointReader> m(t, fem::checkpoint_index(k));
+        measures[k]->load_state(t);
+      }
+    }
+    fem::CheckpointScope<fem::CheckpointReader> run(t, "run");
+    r.loop.next_history = t.read_double("next_history");
+    r.loop.next_frame = t.read_double("next_frame");
+    r.loop.exceeded_reported = t.read_int("exceeded_reported") != 0;
+    r.loop.erosions_logged = static_cast<std::size_t>(t.read_int("erosions_logged"));
+    std::vector<std::int64_t> decades;
+    std::vector<double> errors;
+    t.read_array("max_error_decades", decades);
+    t.read_array("max_error_values", errors, decades.size());
+    r.max_error_by_decade.clear();
+    for (std::size_t k = 0; k < decades.size(); ++k)
+      r.max_error_by_decade[static_cast<int>(decades[k])] = errors[k];
+    r.ke_ie_max = t.read_double("ke_ie_max");
+    r.ke_ie_exceeded = t.read_int("ke_ie_exceeded") != 0;
+    history.load_state(t);
+    frames.load_state(t, s, measures);
+    // The summary as it stood, under this run's header (version, overrides, options).
+    json saved = json::parse(t.read_string("summary"), nullptr, false);
+    if (saved.is_object()) {
+      const json header = summary_header(r.ec, r.options);
+      for (const auto& [key, value] : header.items()) saved[key] = value;
+      for (const auto& [key, value] : r.summary.items())
+        if (!saved.contains(key)) saved[key] = value;
+      r.summary = std::move(saved);
+    }
+  } catch (const fem::CheckpointMismatch& e) {
+    throw InputError((r.dir / kCheckpointFile).string(), "--resume",
+                     std::string("does not fit this model: ") + e.what());
+  }
+  r.wall_before = wall;
+  r.segments = segments + 1;
+  r.checkpoint_cycle = s.cycle();
+  json resumed = r.summary.value("resumed", json::array());
+  resumed.push_back({{"time", s.time()}, {"cycle", s.cycle()}});
+  r.summary["resumed"] = resumed;
 }
 
 // Logs the erosions since the last call; the measures then say what went with them.
@@ -205,23 +409,35 @@ void log_progress(const Run& r, const fem::ExplicitSolver& s, double err) {
 int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHistory& history,
               FrameOutput& frames) {
   const auto& tc = solver.model().time;
-  double next_history = 0, next_frame = 0;
+  double& next_history = r.loop.next_history;
+  double& next_frame = r.loop.next_frame;
   auto last_progress = Clock::now();
-  bool exceeded_reported = false;
-  std::size_t erosions_logged = 0;
+  bool& exceeded_reported = r.loop.exceeded_reported;
+  std::size_t& erosions_logged = r.loop.erosions_logged;
+  const auto& out = r.ec.output;
+  r.last_checkpoint = Clock::now();
   try {
     while (solver.time() < tc.end_time * (1 - 1e-12)) {
       if (tc.max_cycles > 0 && solver.cycle() >= tc.max_cycles) {
         r.status = "max_cycles";
         r.log->warn("stopped at the cycle limit time.max_cycles = {}", tc.max_cycles);
+        write_checkpoint(r, solver, measures, history, frames);
         break;
       }
       if (StopRequest::requested()) {
         r.status = "interrupted";
-        r.log->warn("interrupted at t = {:.6g} s, cycle {}: writing the last frame and summary",
-                    solver.time(), solver.cycle());
+        r.log->warn(
+            "interrupted at t = {:.6g} s, cycle {}: writing a checkpoint, the last frame "
+            "and summary",
+            solver.time(), solver.cycle());
+        write_checkpoint(r, solver, measures, history, frames);
         break;
       }
+      if ((out.checkpoint_every_cycles > 0 && solver.cycle() > 0 &&
+           solver.cycle() % out.checkpoint_every_cycles == 0) ||
+          (out.checkpoint_interval_min > 0 &&
+           seconds_since(r.last_checkpoint) >= 60 * out.checkpoint_interval_min))
+        write_checkpoint(r, solver, measures, history, frames);
       solver.step([&] {
         const double t = solver.time();
         log_erosions(solver, measures, erosions_logged, *r.log);
@@ -333,11 +549,21 @@ std::filesystem::path output_folder(const std::string& case_name, const RunOptio
 
 int run_engine_case(EngineCase& ec, const RunOptions& options) {
   Run r(ec, options);
-  const OutputFolder folder = OutputFolder::claim(r.dir, options.overwrite);
-  r.log = make_run_logger(r.dir, options.verbosity);
-  std::filesystem::copy_file(ec.file, r.dir / "case.toml",
-                             std::filesystem::copy_options::overwrite_existing);
-  write_figure_specs(r.dir, ec);
+  if (options.resume && options.overwrite)
+    throw InputError(ec.file.string(), "--resume",
+                     "continues a run in its own folder: --overwrite does not go with it");
+  r.case_hash = checkpoint_case_hash(ec.file, options.overrides);
+  // --resume: the checkpoint is checked (version, case) before anything is written.
+  fem::CheckpointTree checkpoint;
+  if (options.resume) checkpoint = read_run_checkpoint(r.dir, ec, r.case_hash);
+  const OutputFolder folder =
+      options.resume ? OutputFolder::resume(r.dir) : OutputFolder::claim(r.dir, options.overwrite);
+  r.log = make_run_logger(r.dir, options.verbosity, options.resume);
+  if (!options.resume) {
+    std::filesystem::copy_file(ec.file, r.dir / "case.toml",
+                               std::filesystem::copy_options::overwrite_existing);
+    write_figure_specs(r.dir, ec);
+  }
   log_start(r);
 
   const auto solver_ptr = make_solver(ec, r);
@@ -347,12 +573,18 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   for (const auto& m : measures)
     for (const auto& line : m->setup_lines()) r.log->info("{}", line);
   RunHistory history(r.dir / "history.csv", measures, !ec.samples.empty() || !ec.means.empty());
-  FrameOutput frames(r.dir, ec.output, solver);
+  FrameOutput frames(r.dir, ec.output, solver, options.resume);
+  if (options.resume) {
+    load_checkpoint(r, checkpoint, solver, measures, history, frames);
+    r.log->info("resumed from {} at t = {:.6g} s, cycle {} (segment {})",
+                (r.dir / kCheckpointFile).string(), solver.time(), solver.cycle(), r.segments);
+  }
 
   StopRequest::install();
   r.summary["status"] = "running";
   r.write_summary();
   int exit_code = time_loop(r, solver, measures, history, frames);
+  const bool stopped = r.status == "interrupted" || r.status == "max_cycles";
   frames.close();
   history.finish();
 
@@ -386,6 +618,20 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
         "drawn (ncfsim render {} draws them)",
         r.dir.string());
     if (exit_code == kSuccess) exit_code = kOtherError;
+  }
+  const std::filesystem::path ck = r.dir / kCheckpointFile;
+  std::error_code ec_exists;
+  if (stopped && std::filesystem::exists(ck, ec_exists)) {
+    r.log->warn("checkpoint kept ({}): ncfsim run {} -o {}{} --resume continues the run",
+                ck.string(), r.ec.file.string(), r.dir.string(), [&] {
+                  std::string s;
+                  for (const auto& ov : r.options.overrides)
+                    if (ov.rfind("time.max_cycles=", 0) != 0) s += " --set " + ov;
+                  return s;
+                }());
+  } else if (!stopped && r.status != "numerical_failure") {
+    std::error_code ec_rm;
+    std::filesystem::remove(ck, ec_rm);  // large, and nothing to resume
   }
   r.log->info("results in {} (status: {})", r.dir.string(), r.status);
   folder.finish();

@@ -18,6 +18,8 @@ struct RunOptions {
   int ranks = 1;                      // --np: MPI ranks requested
   std::vector<std::string> force_stages;  // --force: workflow stages rerun although unchanged
   bool overwrite = false;  // --overwrite: write into a folder holding files ncfsim did not write
+  bool resume = false;      // --resume: continue the interrupted run in out_dir from its checkpoint
+  std::string inputs_hash;  // the workflow's hash of the stage's inputs (stored in the checkpoint)
 };
 
 /// Exit codes of the command line (docs/cli.md).

@@ -28,6 +28,12 @@ class RunHistory {
   int index(const std::string& name) const;
   const std::vector<std::vector<double>>& rows() const { return rows_; }
 
+  /// Columns, whether the header is written, the file's length and the kept rows, into a
+  /// checkpoint; load_state cuts history.csv back to that length (rows written after the
+  /// checkpoint go) and appends from there.
+  void save_state(fem::CheckpointWriter& w) const;
+  void load_state(fem::CheckpointReader& r);
+
  private:
   std::filesystem::path file_;
   MeasureList& measures_;

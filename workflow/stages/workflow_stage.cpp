@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 #include <spdlog/logger.h>
-#include <vtksys/MD5.h>
 
 #include <algorithm>
 #include <chrono>
@@ -15,10 +14,13 @@
 
 #include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
+#include "fem/io/hdf5_checkpoint.hpp"
 #include "fem/petsc_vector.hpp"
+#include "workflow/case/case_hash.hpp"
 #include "workflow/output/output_files.hpp"
 #include "workflow/render/render.hpp"
 #include "workflow/report/report.hpp"
+#include "workflow/run/run_checkpoint.hpp"
 #include "workflow/run/run_output.hpp"
 #include "workflow/stages/workflow_case.hpp"
 #include "workflow/version.hpp"
@@ -31,45 +33,6 @@ using json = nlohmann::json;
 namespace {
 
 constexpr const char* kInputsFile = "stage_inputs.json";
-
-class Md5 {
- public:
-  Md5() : h_(vtksysMD5_New()) { vtksysMD5_Initialize(h_); }
-  ~Md5() { vtksysMD5_Delete(h_); }
-  Md5(const Md5&) = delete;
-  Md5& operator=(const Md5&) = delete;
-  void add(const std::string& s) {
-    // Length first: ("ab", "c") and ("a", "bc") must differ.
-    const std::string len = std::to_string(s.size()) + ":";
-    vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(len.data()),
-                     static_cast<int>(len.size()));
-    vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(s.data()),
-                     static_cast<int>(s.size()));
-  }
-  std::string hex() {
-    char out[33] = {};
-    vtksysMD5_FinalizeHex(h_, out);
-    return std::string(out, 32);
-  }
-
- private:
-  vtksysMD5* h_;
-};
-
-// String values of a TOML tree (any depth), with their key paths.
-void string_values(const toml::node& n, const std::string& path,
-                   std::vector<std::pair<std::string, std::string>>& out) {
-  if (const auto* t = n.as_table()) {
-    for (const auto& [k, v] : *t)
-      string_values(v, path.empty() ? std::string(k.str()) : path + "." + std::string(k.str()),
-                    out);
-  } else if (const auto* a = n.as_array()) {
-    for (std::size_t i = 0; i < a->size(); ++i)
-      string_values(*a->get(i), path + "[" + std::to_string(i) + "]", out);
-  } else if (const auto* s = n.as_string()) {
-    out.emplace_back(path, s->get());
-  }
-}
 
 struct StagePlan {
   WorkflowStageSpec spec;
@@ -168,6 +131,24 @@ StageOutcome run_planned_stage(const StagePlan& p, const RunOptions& options, sp
   sc.options.out_dir = p.folder;
   sc.options.overrides = p.overrides;
   sc.options.force_stages.clear();
+  // --resume reaches the stage that stopped with a checkpoint of these very inputs.
+  sc.options.inputs_hash = p.hash;
+  sc.options.resume = false;
+  if (options.resume && fs::exists(p.folder / kCheckpointFile)) {
+    std::string hash;
+    try {
+      fem::CheckpointTree t = fem::io::read_checkpoint_file(p.folder / kCheckpointFile);
+      t.set_reading(true);
+      hash = t.read_string("inputs_hash");
+    } catch (const std::exception&) {
+    }
+    if (hash == p.hash) {
+      sc.options.resume = true;
+      log.info("{} resuming from its checkpoint", tag);
+    } else {
+      log.warn("{} checkpoint of other inputs discarded: the stage runs from the start", tag);
+    }
+  }
   StageOutcome o;
   try {
     o.rc = find_stage(p.kind, p.spec.case_file).run(sc);

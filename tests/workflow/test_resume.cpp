@@ -1,0 +1,180 @@
+// Resumable runs (issue #22, docs/checkpoint-plan.md tests 6.3-6.4) on a contact case: the
+// tow-on-tow friction sled (penalty contact with friction, ties, a load, damping, a velocity-driven
+// carriage), cut to 12 ms (~18,000 cycles, a few seconds). U runs to the end; R is killed with
+// SIGKILL after its second checkpoint (output.checkpoint_every_cycles), or stopped with SIGINT,
+// or by time.max_cycles, then continued with --resume. R must give U's history.csv byte for
+// byte, the same summary.json values (energies, forces, friction coefficient; wall time and
+// memory aside), the same results.xdmf, results.h5 frames and results.pvd. A checkpoint of
+// another case or another ncfsim version, or --resume where there is no checkpoint, is refused
+// with exit 2 and a message that says why.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "fem/checkpoint.hpp"
+#include "fem/io/hdf5_checkpoint.hpp"
+#include "fem/io/result_reader.hpp"
+#include "tests/workflow/cli_test_support.hpp"
+
+namespace ncfsim::test {
+namespace {
+
+const fs::path kSled = kSource / "cases/drape/friction_sled_tow_tow_0_90.toml";
+
+std::vector<std::string> sled_run(const fs::path& out, std::vector<std::string> extra = {}) {
+  std::vector<std::string> a = {"-q",
+                                "run",
+                                kSled.string(),
+                                "-o",
+                                out.string(),
+                                "--set",
+                                "time.end_time=0.012",
+                                "--set",
+                                "output.figures=false",
+                                "--set",
+                                "output.frames=both",
+                                "--set",
+                                "output.checkpoint_every_cycles=2000"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+nlohmann::json summary(const fs::path& out) {
+  return nlohmann::json::parse(slurp(out / "summary.json"));
+}
+
+int count(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+// The uninterrupted run, once for all tests.
+const fs::path& uninterrupted() {
+  static const fs::path out = [] {
+    const fs::path o = fresh_dir("resume_uninterrupted");
+    const auto r = run_cli(sled_run(o));
+    EXPECT_EQ(r.code, 0) << r.output;
+    return o;
+  }();
+  return out;
+}
+
+// R against U: the same files and values.
+void expect_same_results(const fs::path& u, const fs::path& r) {
+  EXPECT_EQ(slurp(u / "history.csv"), slurp(r / "history.csv"));
+  EXPECT_EQ(slurp(u / "results.xdmf"), slurp(r / "results.xdmf"));
+  EXPECT_EQ(slurp(u / "results.pvd"), slurp(r / "results.pvd"));
+  EXPECT_FALSE(fs::exists(r / "checkpoint.h5")) << "a completed run removes its checkpoint";
+  const auto su = summary(u), sr = summary(r);
+  EXPECT_EQ(sr["status"], "completed");
+  ASSERT_TRUE(sr.contains("resumed"));
+  for (const auto& [key, value] : su.items()) {
+    if (key == "wall_seconds" || key == "peak_memory_MB" || key == "timers_s" || key == "overrides")
+      continue;
+    EXPECT_EQ(value, sr[key]) << key;
+  }
+  const fem::io::ResultReader hu(u / "results.h5"), hr(r / "results.h5");
+  ASSERT_EQ(hu.n_frames(), hr.n_frames());
+  for (std::size_t k = 0; k < hu.n_frames(); ++k) {
+    const auto fu = hu.frame(k), fr = hr.frame(k);
+    EXPECT_EQ(fu.time, fr.time);
+    EXPECT_EQ(fu.cycle, fr.cycle);
+    EXPECT_EQ(fu.coordinates, fr.coordinates) << "frame " << k;
+  }
+}
+
+// Waits until log.txt of `out` holds `n` checkpoint lines (false after ~60 s).
+bool wait_for_checkpoints(const fs::path& out, int n) {
+  for (int i = 0; i < 6000; ++i) {
+    if (count(slurp(out / "log.txt"), "checkpoint at t =") >= n) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+TEST(CliRegressionResume, KilledWithSigkillAndResumedGivesTheSameResults) {
+  const fs::path u = uninterrupted();
+  const fs::path r = fresh_dir("resume_sigkill");
+  const fs::path log = r.string() + ".log";
+  const pid_t pid = spawn(sled_run(r), log);
+  ASSERT_TRUE(wait_for_checkpoints(r, 2)) << slurp(log);
+  kill(pid, SIGKILL);
+  wait_code(pid);
+  ASSERT_TRUE(fs::exists(r / "checkpoint.h5"));
+  EXPECT_EQ(summary(r)["status"], "running");
+  const auto res = run_cli(sled_run(r, {"--resume"}));
+  ASSERT_EQ(res.code, 0) << res.output;
+  EXPECT_NE(slurp(r / "log.txt").find("resumed from"), std::string::npos);
+  expect_same_results(u, r);
+}
+
+TEST(CliRegressionResume, InterruptedWithSigintKeepsTheCheckpointAndSaysHowToResume) {
+  const fs::path u = uninterrupted();
+  const fs::path r = fresh_dir("resume_sigint");
+  const fs::path log = r.string() + ".log";
+  const pid_t pid = spawn(sled_run(r), log);
+  ASSERT_TRUE(wait_for_checkpoints(r, 1)) << slurp(log);
+  kill(pid, SIGINT);
+  EXPECT_EQ(wait_code(pid), 1) << slurp(log);
+  EXPECT_EQ(summary(r)["status"], "interrupted");
+  ASSERT_TRUE(fs::exists(r / "checkpoint.h5"));
+  EXPECT_NE(slurp(log).find("--resume continues the run"), std::string::npos) << slurp(log);
+  const auto res = run_cli(sled_run(r, {"--resume"}));
+  ASSERT_EQ(res.code, 0) << res.output;
+  expect_same_results(u, r);
+}
+
+TEST(CliRegressionResume, CycleLimitThenResumeWithoutIt) {
+  const fs::path u = uninterrupted();
+  const fs::path r = fresh_dir("resume_max_cycles");
+  const auto first = run_cli(sled_run(r, {"--set", "time.max_cycles=7000"}));
+  ASSERT_EQ(first.code, 1) << first.output;
+  EXPECT_EQ(summary(r)["status"], "max_cycles");
+  const auto res = run_cli(sled_run(r, {"--resume"}));
+  ASSERT_EQ(res.code, 0) << res.output;
+  expect_same_results(u, r);
+}
+
+TEST(CliRegressionResume, CheckpointOfAnotherCaseOrVersionOrNoneIsRefused) {
+  // No checkpoint: a completed run's folder.
+  {
+    const auto res = run_cli(sled_run(uninterrupted(), {"--resume"}));
+    EXPECT_EQ(res.code, 2) << res.output;
+    EXPECT_NE(res.output.find("holds no checkpoint.h5"), std::string::npos) << res.output;
+  }
+  const fs::path r = fresh_dir("resume_refusals");
+  ASSERT_EQ(run_cli(sled_run(r, {"--set", "time.max_cycles=3000"})).code, 1);
+  ASSERT_TRUE(fs::exists(r / "checkpoint.h5"));
+  const std::string before = slurp(r / "history.csv");
+  // Another case (another key value).
+  {
+    const auto res =
+        run_cli(sled_run(r, {"--set", "load.nodal_force[0].ramp_time=0.004", "--resume"}));
+    EXPECT_EQ(res.code, 2) << res.output;
+    EXPECT_NE(res.output.find("is a checkpoint of case 'friction_sled_tow_tow_0_90'"),
+              std::string::npos)
+        << res.output;
+    EXPECT_NE(res.output.find("not of this case"), std::string::npos) << res.output;
+  }
+  // Another ncfsim version.
+  {
+    fem::CheckpointTree t = fem::io::read_checkpoint_file(r / "checkpoint.h5");
+    t.root().values["ncfsim_version"] = std::string("0.0.1-other");
+    fem::io::write_checkpoint_file(r / "checkpoint.h5", t);
+    const auto res = run_cli(sled_run(r, {"--resume"}));
+    EXPECT_EQ(res.code, 2) << res.output;
+    EXPECT_NE(res.output.find("is a checkpoint of ncfsim 0.0.1-other, this is ncfsim"),
+              std::string::npos)
+        << res.output;
+  }
+  // Refused before anything was written.
+  EXPECT_EQ(slurp(r / "history.csv"), before);
+  EXPECT_EQ(summary(r)["status"], "max_cycles");
+}
+
+}  // namespace
+}  // namespace ncfsim::test

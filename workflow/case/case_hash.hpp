@@ -1,0 +1,53 @@
+#pragma once
+// Hashes of a case's inputs: the MD5 of the workflow's stage inputs (workflow_stage.cpp) and of a
+// checkpoint's case (workflow/run/run_checkpoint.cpp).
+#include <toml++/toml.h>
+#include <vtksys/MD5.h>
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace ncfsim::workflow {
+
+class Md5 {
+ public:
+  Md5() : h_(vtksysMD5_New()) { vtksysMD5_Initialize(h_); }
+  ~Md5() { vtksysMD5_Delete(h_); }
+  Md5(const Md5&) = delete;
+  Md5& operator=(const Md5&) = delete;
+  void add(const std::string& s) {
+    // Length first: ("ab", "c") and ("a", "bc") must differ.
+    const std::string len = std::to_string(s.size()) + ":";
+    vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(len.data()),
+                     static_cast<int>(len.size()));
+    vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(s.data()),
+                     static_cast<int>(s.size()));
+  }
+  std::string hex() {
+    char out[33] = {};
+    vtksysMD5_FinalizeHex(h_, out);
+    return std::string(out, 32);
+  }
+
+ private:
+  vtksysMD5* h_;
+};
+
+/// String values of a TOML tree (any depth), with their key paths.
+inline void string_values(const toml::node& n, const std::string& path,
+                          std::vector<std::pair<std::string, std::string>>& out) {
+  if (const auto* t = n.as_table()) {
+    for (const auto& [k, v] : *t)
+      string_values(v, path.empty() ? std::string(k.str()) : path + "." + std::string(k.str()),
+                    out);
+  } else if (const auto* a = n.as_array()) {
+    for (std::size_t i = 0; i < a->size(); ++i)
+      string_values(*a->get(i), path + "[" + std::to_string(i) + "]", out);
+  } else if (const auto* s = n.as_string()) {
+    out.emplace_back(path, s->get());
+  }
+}
+
+}  // namespace ncfsim::workflow
