@@ -176,5 +176,34 @@ TEST(CliRegressionResume, CheckpointOfAnotherCaseOrVersionOrNoneIsRefused) {
   EXPECT_EQ(summary(r)["status"], "max_cycles");
 }
 
+// A workflow stopped in its second stage keeps the first and the stage's checkpoint, says how to
+// go on; `--resume` skips the first, resumes the second and runs the third: the second stage's
+// results equal an unbroken workflow's.
+TEST(CliRegressionResume, WorkflowStoppedInAStageResumesIt) {
+  const fs::path chain = kSource / "tests/cases/workflow/chain.toml";
+  const fs::path w1 = fresh_dir("resume_workflow_unbroken");
+  const auto u = run_cli({"-q", "run", chain.string(), "-o", w1.string()});
+  ASSERT_EQ(u.code, 0) << u.output;
+  const fs::path w2 = fresh_dir("resume_workflow");
+  const auto first =
+      run_cli({"run", chain.string(), "-o", w2.string(), "--set", "b.time.max_cycles=40"});
+  ASSERT_EQ(first.code, 1) << first.output;
+  EXPECT_NE(first.output.find("kept: a"), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find("stage 'b' kept its checkpoint"), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find(" -o " + w2.string() + " --resume continues it"), std::string::npos)
+      << first.output;
+  ASSERT_TRUE(fs::exists(w2 / "b/checkpoint.h5"));
+  const auto res = run_cli({"run", chain.string(), "-o", w2.string(), "--resume"});
+  ASSERT_EQ(res.code, 0) << res.output;
+  EXPECT_NE(res.output.find("resuming from its checkpoint"), std::string::npos) << res.output;
+  EXPECT_EQ(slurp(w1 / "b/history.csv"), slurp(w2 / "b/history.csv"));
+  const auto s1 = summary(w1 / "b"), s2 = summary(w2 / "b");
+  EXPECT_EQ(s2["status"], "completed");
+  for (const auto& [key, value] : s1.items())
+    if (value.is_number_float() && key != "wall_seconds" && key != "peak_memory_MB")
+      EXPECT_EQ(value, s2[key]) << key;
+  EXPECT_TRUE(fs::exists(w2 / "c/summary.json"));
+}
+
 }  // namespace
 }  // namespace ncfsim::test

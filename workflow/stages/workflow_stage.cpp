@@ -46,8 +46,16 @@ struct StagePlan {
 // The stage's inputs and their hash; the upstream hashes are those of plans already made.
 void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream_hash) {
   const fem::CaseDocument doc = fem::CaseDocument::load(p.spec.case_file, p.overrides);
+  // Less the keys that do not change what a completed stage holds (a stage stopped by its cycle
+  // limit is resumed with the same hash: checkpoint_case_hash leaves out the same keys).
+  toml::table root = doc.root();
+  if (auto* t = root["time"].as_table()) t->erase("max_cycles");
+  if (auto* o = root["output"].as_table()) {
+    o->erase("checkpoint_interval");
+    o->erase("checkpoint_every_cycles");
+  }
   std::ostringstream resolved;
-  resolved << doc.root();
+  resolved << root;
   Md5 md5;
   md5.add(kVersion);
   md5.add(resolved.str());
@@ -211,6 +219,7 @@ int run_workflow_stage(const StageCall& call) {
   }
   int code = kSuccess;
   std::string stop_reason;
+  const StagePlan* resumable = nullptr;  // the stage that stopped with a checkpoint
   for (std::size_t k = 0; k < n; ++k) {
     const StagePlan& p = plans[k];
     const std::string tag = fmt::format("[{}/{} {}]", k + 1, n, p.spec.name);
@@ -265,6 +274,7 @@ int run_workflow_stage(const StageCall& call) {
     if (StopRequest::requested() && stop_reason.empty() && k + 1 < n)
       stop_reason = "interrupted (SIGINT/SIGTERM)";
     if (!stop_reason.empty() && StopRequest::requested()) code = kOtherError;
+    if (!stop_reason.empty() && fs::exists(p.folder / kCheckpointFile)) resumable = &p;
   }
   summary["wall_seconds"] = wall();
   summary["status"] = stop_reason.empty()        ? "completed"
@@ -283,11 +293,22 @@ int run_workflow_stage(const StageCall& call) {
     for (const auto& e : summary["stages"])
       if (e["status"] == "completed" || e["status"] == "skipped")
         kept += (kept.empty() ? "" : ", ") + e["name"].get<std::string>();
-    log->warn(
-        "workflow stopped: {}; kept: {} (their results stand); {} the same command to go "
-        "on: the kept stages are skipped",
-        stop_reason, kept.empty() ? "none" : kept,
-        code == kBadInput ? "correct the input and rerun" : "rerun");
+    if (resumable) {
+      std::string command = "ncfsim run " + call.case_file.string() + " -o " + out.string();
+      for (const auto& ov : call.overrides)  // a cycle limit would stop it again
+        if (ov.find("time.max_cycles=") == std::string::npos) command += " --set " + ov;
+      log->warn(
+          "workflow stopped: {}; kept: {} (their results stand); stage '{}' kept its checkpoint "
+          "({}): {} --resume continues it (the kept stages are skipped)",
+          stop_reason, kept.empty() ? "none" : kept, resumable->spec.name,
+          (resumable->folder / kCheckpointFile).string(), command);
+    } else {
+      log->warn(
+          "workflow stopped: {}; kept: {} (their results stand); {} the same command to go "
+          "on: the kept stages are skipped",
+          stop_reason, kept.empty() ? "none" : kept,
+          code == kBadInput ? "correct the input and rerun" : "rerun");
+    }
   } else {
     log->info("workflow '{}' completed in {}: {}", wc.name, hms(wall()), out.string());
   }
