@@ -17,6 +17,7 @@
 #include "fem/checkpoint.hpp"
 #include "fem/io/hdf5_checkpoint.hpp"
 #include "fem/io/result_reader.hpp"
+#include "tests/flat_blanket_case.hpp"
 #include "tests/workflow/cli_test_support.hpp"
 
 namespace ncfsim::test {
@@ -203,6 +204,96 @@ TEST(CliRegressionResume, WorkflowStoppedInAStageResumesIt) {
     if (value.is_number_float() && key != "wall_seconds" && key != "peak_memory_MB")
       EXPECT_EQ(value, s2[key]) << key;
   EXPECT_TRUE(fs::exists(w2 / "c/summary.json"));
+}
+
+// The crush stage (tow damage with erosion, cohesive resin ties, penalty contact, the punch force
+// filtered at CFC 600 over the whole curve when the run ends) of
+// tests/workflow/test_crush_case.cpp, stopped by its cycle limit and resumed: the same history.csv
+// (the filtered column included) and summary.json values as an uninterrupted crush.
+TEST(CliRegressionResume, CrushStoppedAndResumedGivesTheSameResults) {
+  const fs::path dir = fresh_dir("resume_crush");
+  fs::create_directories(dir);
+  std::ofstream(dir / "blanket.toml") << kFlatBlanketBriefRun;
+  std::ofstream(dir / "transfer.toml") << R"([case]
+name = "flat_transfer"
+kind = "transfer"
+[source]
+results = "drape/results.h5"
+[output]
+figures = false
+)";
+  ASSERT_EQ(
+      run_cli({"-q", "run", (dir / "blanket.toml").string(), "-o", (dir / "drape").string()}).code,
+      0);
+  ASSERT_EQ(
+      run_cli({"-q", "run", (dir / "transfer.toml").string(), "-o", (dir / "transfer").string()})
+          .code,
+      0);
+  const auto crush = [&](const fs::path& out, std::vector<std::string> extra) {
+    std::vector<std::string> a = {"-q",
+                                  "run",
+                                  (kSource / "cases/hemisphere/crush.toml").string(),
+                                  "-o",
+                                  out.string(),
+                                  "--set",
+                                  "model.source=" + (dir / "transfer" / "results.h5").string(),
+                                  "--set",
+                                  "model.damage.fracture_energy.fibre_tension=300000.0",
+                                  "--set",
+                                  "model.damage.fracture_energy.fibre_compression=110000.0",
+                                  "--set",
+                                  "model.damage.fracture_energy.matrix_tension=1400.0",
+                                  "--set",
+                                  "model.damage.fracture_energy.transverse_shear=1600.0",
+                                  "--set",
+                                  "tool[0].point=[0.03,0.03,0.02551]",
+                                  "--set",
+                                  "tool[0].ramp_time=1e-6",
+                                  "--set",
+                                  "tool[1].point=[0.0,0.0,-1e-5]",
+                                  "--set",
+                                  "time.end_time=1.5e-4",
+                                  "--set",
+                                  "time.quasi_static_from=8e-5",
+                                  "--set",
+                                  "time.history_interval=2.5e-6",
+                                  "--set",
+                                  "time.frame_interval=5e-5",
+                                  "--set",
+                                  "output.figures=false",
+                                  "--set",
+                                  "output.report=false"};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return run_cli(a);
+  };
+  const fs::path u = dir / "crush_u", r = dir / "crush_r";
+  const auto ru = crush(u, {});
+  ASSERT_EQ(ru.code, 0) << ru.output;
+  const auto su = summary(u);
+  ASSERT_GT(su["cycles"].get<double>(), 100.0);
+  const auto stop = static_cast<int>(0.6 * su["cycles"].get<double>());
+  const auto first = crush(r, {"--set", "time.max_cycles=" + std::to_string(stop)});
+  ASSERT_EQ(first.code, 1) << first.output;
+  const auto res = crush(r, {"--resume"});
+  ASSERT_EQ(res.code, 0) << res.output;
+  EXPECT_EQ(slurp(u / "history.csv"), slurp(r / "history.csv"));
+  // Elements failed and were eroded after the restart, too.
+  const History h = read_history(u / "history.csv");
+  const std::size_t c_failed = h.column("failed_elements"), c_time = h.column("time");
+  ASSERT_LT(c_failed, h.columns.size());
+  ASSERT_LT(c_time, h.columns.size());
+  const double t_stop = summary(r)["resumed"][0]["time"].get<double>();
+  double failed_at_stop = 0;
+  for (const auto& row : h.rows)
+    if (row[c_time] <= t_stop) failed_at_stop = row[c_failed];
+  EXPECT_GT(h.rows.back()[c_failed], failed_at_stop) << "no element failed after the restart";
+  const auto sr = summary(r);
+  for (const auto& [key, value] : su.items()) {
+    if (key == "wall_seconds" || key == "peak_memory_MB" || key == "timers_s" || key == "overrides")
+      continue;
+    EXPECT_EQ(value, sr[key]) << key;
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace
