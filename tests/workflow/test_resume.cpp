@@ -206,6 +206,45 @@ TEST(CliRegressionResume, WorkflowStoppedInAStageResumesIt) {
   EXPECT_TRUE(fs::exists(w2 / "c/summary.json"));
 }
 
+// Ctrl-C in a workflow's long stage: the finished stage and the stage's checkpoint are kept, the
+// console says so and gives the command; --resume continues the stage to the uninterrupted
+// run's history.csv.
+TEST(CliRegressionResume, WorkflowInterruptedWithSigintKeepsStagesAndCheckpoint) {
+  const fs::path dir = fresh_dir("resume_workflow_sigint");
+  fs::create_directories(dir);
+  std::ofstream(dir / "workflow.toml")
+      << "[case]\nname = \"two\"\nkind = \"workflow\"\n[[stage]]\nname = \"a\"\ncase = \""
+      << (kSource / "tests/cases/workflow/cube_a.toml").string()
+      << "\"\n[[stage]]\nname = \"sled\"\ncase = \"" << kSled.string() << "\"\nafter = [\"a\"]\n";
+  const fs::path out = dir / "out";
+  const std::vector<std::string> args = {"run",   (dir / "workflow.toml").string(),
+                                         "-o",    out.string(),
+                                         "--set", "sled.time.end_time=0.012",
+                                         "--set", "sled.output.figures=false",
+                                         "--set", "sled.output.frames=both",
+                                         "--set", "sled.output.checkpoint_every_cycles=2000"};
+  const fs::path log = dir / "console.log";
+  const pid_t pid = spawn(args, log);
+  ASSERT_TRUE(wait_for_checkpoints(out / "sled", 1)) << slurp(log);
+  kill(pid, SIGINT);
+  EXPECT_EQ(wait_code(pid), 1) << slurp(log);
+  const std::string console = slurp(log);
+  EXPECT_NE(console.find("kept: a"), std::string::npos) << console;
+  EXPECT_NE(console.find("stage 'sled' kept its checkpoint"), std::string::npos) << console;
+  EXPECT_NE(console.find("--resume continues it"), std::string::npos) << console;
+  ASSERT_TRUE(fs::exists(out / "sled/checkpoint.h5"));
+  EXPECT_EQ(summary(out / "a")["status"], "completed");
+  std::vector<std::string> again = args;
+  again.push_back("--resume");
+  const auto res = run_cli(again);
+  ASSERT_EQ(res.code, 0) << res.output;
+  EXPECT_NE(res.output.find("[1/2 a] unchanged"), std::string::npos) << res.output;
+  EXPECT_NE(res.output.find("resuming from its checkpoint"), std::string::npos) << res.output;
+  EXPECT_EQ(slurp(uninterrupted() / "history.csv"), slurp(out / "sled/history.csv"));
+  EXPECT_EQ(summary(out / "sled")["status"], "completed");
+  fs::remove_all(dir);
+}
+
 // The crush stage (tow damage with erosion, cohesive resin ties, penalty contact, the punch force
 // filtered at CFC 600 over the whole curve when the run ends) of
 // tests/workflow/test_crush_case.cpp, stopped by its cycle limit and resumed: the same history.csv
