@@ -397,7 +397,7 @@ void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size
 
 void log_progress(const Run& r, const fem::ExplicitSolver& s, double err) {
   const auto& tc = s.model().time;
-  const double t = s.time(), wall = seconds_since(r.wall0), frac = t / tc.end_time;
+  const double t = s.time(), wall = r.wall_seconds(), frac = t / tc.end_time;
   r.log->info(
       "t = {:.4e} / {:.4e} s ({:4.1f} %) | cycle {} | dt {:.3e} s | wall {} | ETA {} | energy "
       "balance {:.3f} %",
