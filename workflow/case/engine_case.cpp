@@ -78,8 +78,7 @@ void read_output(const CaseReadContext& ctx, EngineCase& ec) {
   ec.output.vtu = frames == "vtu" || frames == "both";
   ec.output.figures = o->boolean("figures", true);
   ec.output.report = o->boolean("report", false);
-  ec.output.checkpoint_interval_min =
-      o->number("checkpoint_interval", 10.0, Range::closed(0, 1e4));
+  ec.output.checkpoint_interval_min = o->number("checkpoint_interval", 10.0, Range::closed(0, 1e4));
   ec.output.checkpoint_every_cycles =
       o->integer("checkpoint_every_cycles", 0, 0, std::int64_t{1} << 40);
   for (const auto& t : o->tables("probe"))

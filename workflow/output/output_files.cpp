@@ -24,8 +24,8 @@ std::shared_ptr<spdlog::logger> make_run_logger(const std::filesystem::path& out
                                                : spdlog::level::info);
   std::vector<spdlog::sink_ptr> sinks{console};
   if (!out_dir.empty()) {
-    auto file =
-        std::make_shared<spdlog::sinks::basic_file_sink_mt>((out_dir / "log.txt").string(), !append);
+    auto file = std::make_shared<spdlog::sinks::basic_file_sink_mt>((out_dir / "log.txt").string(),
+                                                                    !append);
     file->set_pattern("[%Y-%m-%d %H:%M:%S] %v");
     file->set_level(v == Verbosity::Verbose ? spdlog::level::debug : spdlog::level::info);
     sinks.push_back(file);
@@ -208,9 +208,9 @@ OutputFolder OutputFolder::resume(const std::filesystem::path& dir) {
   const fs::path manifest = dir / kManifest;
   const nlohmann::json m = read_json_file(manifest);
   if (!m.is_object())
-    throw InputError(dir.string(), "--resume",
-                     "is not an output folder of ncfsim (no readable " + std::string(kManifest) +
-                         ")");
+    throw InputError(
+        dir.string(), "--resume",
+        "is not an output folder of ncfsim (no readable " + std::string(kManifest) + ")");
   OutputFolder o;
   o.dir_ = dir;
   o.before_files_ = m.value("before_files", std::vector<std::string>{});

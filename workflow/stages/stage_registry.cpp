@@ -134,9 +134,9 @@ int run_stage(const StageCall& call) {
   const std::string kind = case_kind(call.case_file, call.overrides);
   // Only time-loop runs write checkpoints; the other stages are short and rerun.
   if (call.options.resume && kind != "engine" && kind != "crush" && kind != "workflow")
-    throw InputError(call.case_file.string(), "--resume",
-                     "a '" + kind +
-                         "' stage keeps no checkpoint (it is short): run it without --resume");
+    throw InputError(
+        call.case_file.string(), "--resume",
+        "a '" + kind + "' stage keeps no checkpoint (it is short): run it without --resume");
   return find_stage(kind, call.case_file).run(call);
 }
 
