@@ -71,7 +71,11 @@ class FrameOutput {
     if (settings_.xdmf) {
       const fs::path h5 = dir_ / "results.h5", old = dir_ / "results.h5.resume";
       std::error_code ec;
-      if (fs::exists(h5, ec)) fs::rename(h5, old);
+      // results.h5.resume left by a resume that failed holds the frames: it is kept.
+      if (fs::exists(old, ec))
+        fs::remove(h5, ec);
+      else if (fs::exists(h5, ec))
+        fs::rename(h5, old);
       if (written_ > 0 && !fs::exists(old, ec))
         throw InputError(h5.string(), "--resume",
                          "is missing: the frames before the checkpoint are gone");
