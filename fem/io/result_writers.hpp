@@ -131,6 +131,18 @@ void validate_mesh(const ResultMesh& mesh);
 /// Throws std::invalid_argument if the frame does not fit the mesh.
 void validate_frame(const ResultMesh& mesh, const Frame& frame);
 
+/// What results.xdmf says of a frame already in results.h5 (XdmfResultWriter::reopen).
+struct WrittenFrame {
+  double time = 0.0;
+  int cycle = 0;
+  struct Field {
+    std::string name;
+    bool on_cells = false;
+    int n_components = 1;
+  };
+  std::vector<Field> fields;  // in the order the frame had them
+};
+
 class XdmfResultWriter {
  public:
   /// Creates out_dir if needed, replaces results.xdmf by an empty time series, then creates
@@ -152,9 +164,20 @@ class XdmfResultWriter {
   std::size_t frames_written() const;
   const std::filesystem::path& h5_path() const;
   const std::filesystem::path& xdmf_path() const;
+  /// The frames as results.xdmf lists them (what reopen takes back).
+  std::vector<WrittenFrame> written_frames() const;
+
+  /// Takes over the results.h5 an earlier writer of this mesh left in out_dir (a resumed run):
+  /// keeps its first `frames.size()` frames (their groups as they are), deletes the groups of
+  /// later ones, rewrites results.xdmf with the kept frames; write_frame goes on after them.
+  /// Throws std::runtime_error naming the file when it cannot be opened, holds another mesh
+  /// (number of points or cells) or fewer frames.
+  static XdmfResultWriter reopen(std::filesystem::path out_dir, ResultMesh mesh,
+                                 const std::vector<WrittenFrame>& frames);
 
  private:
   struct Impl;
+  explicit XdmfResultWriter(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -532,6 +532,77 @@ void XdmfResultWriter::close() {
   impl_->closed = true;
 }
 
+XdmfResultWriter::XdmfResultWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+std::vector<WrittenFrame> XdmfResultWriter::written_frames() const {
+  std::vector<WrittenFrame> out;
+  if (!impl_) return out;
+  for (const auto& fr : impl_->frames) {
+    WrittenFrame w{fr.time, fr.cycle, {}};
+    for (const auto& f : fr.fields) w.fields.push_back({f.name, f.on_cells, f.n_components});
+    out.push_back(std::move(w));
+  }
+  return out;
+}
+
+XdmfResultWriter XdmfResultWriter::reopen(std::filesystem::path out_dir, ResultMesh mesh,
+                                          const std::vector<WrittenFrame>& frames) {
+  validate_mesh(mesh);
+  auto impl = std::make_unique<Impl>();
+  impl->dir = std::move(out_dir);
+  impl->h5 = impl->dir / kH5Name;
+  impl->xdmf = impl->dir / kXdmfName;
+  impl->mesh = std::move(mesh);
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    Impl::FrameRecord record{
+        frames[k].time, frames[k].cycle, "/frames/" + detail::zero_padded(k, kFrameDigits), {}};
+    for (const auto& f : frames[k].fields)
+      record.fields.push_back({f.name, f.on_cells, f.n_components});
+    impl->frames.push_back(std::move(record));
+  }
+  {
+    SilenceH5Errors silence;
+    const H5Where root = impl->at("/");
+    if (!std::filesystem::is_regular_file(impl->h5))
+      throw std::runtime_error("'" + impl->h5.string() + "' does not exist");
+    H5Id fapl = make_fapl(impl->h5);
+    H5Id file(h5_check_id(H5Fopen(impl->h5.c_str(), H5F_ACC_RDWR, fapl.get()), root, "H5Fopen"),
+              H5Fclose);
+    {  // the same mesh: its points and cells
+      const H5Where where = impl->at("/mesh/points");
+      H5Id d(h5_check_id(H5Dopen2(file.get(), "/mesh/points", H5P_DEFAULT), where, "H5Dopen2"),
+             H5Dclose);
+      H5Id space(h5_check_id(H5Dget_space(d.get()), where, "H5Dget_space"), H5Sclose);
+      hsize_t dims[2] = {0, 0};
+      H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+      if (dims[0] != impl->mesh.n_points())
+        throw std::runtime_error("'" + impl->h5.string() + "' holds a mesh of " +
+                                 std::to_string(dims[0]) + " points, this run's has " +
+                                 std::to_string(impl->mesh.n_points()));
+    }
+    // The kept frames must be there; the groups of later ones go.
+    for (std::size_t k = 0;; ++k) {
+      const std::string group = "/frames/" + detail::zero_padded(k, kFrameDigits);
+      const htri_t exists = H5Lexists(file.get(), group.c_str(), H5P_DEFAULT);
+      h5_check(exists < 0 ? -1 : 0, impl->at(group), "H5Lexists");
+      if (k < frames.size()) {
+        if (exists <= 0)
+          throw std::runtime_error("'" + impl->h5.string() + "' lacks frame " + group +
+                                   " of the run it continues");
+        continue;
+      }
+      if (exists <= 0) break;
+      h5_check(H5Ldelete(file.get(), group.c_str(), H5P_DEFAULT), impl->at(group), "H5Ldelete");
+    }
+    const auto n_frames = static_cast<std::int32_t>(frames.size());
+    write_scalar_attribute(file.get(), "n_frames", H5T_STD_I32LE, H5T_NATIVE_INT32, n_frames, root);
+    h5_check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), root, "H5Fflush");
+    h5_check(file.close(), root, "H5Fclose");
+  }
+  detail::atomic_write_text(impl->xdmf, impl->xdmf_text());
+  return XdmfResultWriter(std::move(impl));
+}
+
 std::size_t XdmfResultWriter::frames_written() const { return impl_ ? impl_->frames.size() : 0; }
 const std::filesystem::path& XdmfResultWriter::h5_path() const { return impl_->h5; }
 const std::filesystem::path& XdmfResultWriter::xdmf_path() const { return impl_->xdmf; }

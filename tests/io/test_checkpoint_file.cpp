@@ -6,10 +6,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "fem/checkpoint.hpp"
 #include "fem/io/hdf5_checkpoint.hpp"
+#include "fem/io/result_reader.hpp"
+#include "fem/io/result_writers.hpp"
 
 namespace fs = std::filesystem;
 using ncfsim::fem::CheckpointMismatch;
@@ -143,4 +146,63 @@ TEST(CheckpointFile, WriteIsAtomicAndBadFilesAreRefused) {
   std::ofstream(dir / "text.h5") << "not hdf5\n";
   EXPECT_THROW(read_checkpoint_file(dir / "text.h5"), CheckpointMismatch);
   fs::remove_all(dir);
+}
+
+// A resumed run takes over results.h5 (XdmfResultWriter::reopen): the frames before the
+// checkpoint stay, later ones go, and the next frames follow them; results.xdmf and the frames
+// read back are those of a writer that never stopped.
+TEST(CheckpointFile, ResultsReopenedKeepTheFramesBeforeTheCheckpoint) {
+  namespace io = ncfsim::fem::io;
+  io::ResultMesh mesh;
+  for (int k = 0; k < 8; ++k)
+    mesh.points.insert(mesh.points.end(), {double(k & 1), double((k >> 1) & 1), double(k >> 2)});
+  mesh.hex8 = {0, 1, 3, 2, 4, 5, 7, 6};
+  mesh.hex_part = {0};
+  mesh.part_names = {"cube"};
+  auto frame = [](double t) {
+    io::Frame f;
+    f.time = t;
+    f.cycle = static_cast<int>(10 * t);
+    f.displacement.assign(24, t);
+    f.fields.push_back({"s", true, 1, {2 * t}});
+    f.fields.push_back({"a", false, 1, std::vector<double>(8, t)});
+    return f;
+  };
+  const fs::path one = temp_dir("reopen_one"), two = temp_dir("reopen_two");
+  {
+    io::XdmfResultWriter w(one, mesh);
+    for (double t : {0.0, 1.0, 2.0, 3.0}) w.write_frame(frame(t));
+  }
+  std::vector<io::WrittenFrame> kept;
+  {
+    io::XdmfResultWriter w(two, mesh);
+    for (double t : {0.0, 1.0}) w.write_frame(frame(t));
+    kept = w.written_frames();
+    w.write_frame(frame(1.5));  // written after the checkpoint: goes
+  }
+  {
+    io::XdmfResultWriter w = io::XdmfResultWriter::reopen(two, mesh, kept);
+    EXPECT_EQ(w.frames_written(), 2u);
+    for (double t : {2.0, 3.0}) w.write_frame(frame(t));
+  }
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(slurp(one / "results.xdmf"), slurp(two / "results.xdmf"));
+  const io::ResultReader a(one / "results.h5"), b(two / "results.h5");
+  ASSERT_EQ(b.n_frames(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(a.frame(k).time, b.frame(k).time);
+    EXPECT_EQ(a.frame(k).coordinates, b.frame(k).coordinates);
+  }
+  // Another mesh, or fewer frames than the checkpoint's, is refused.
+  io::ResultMesh other = mesh;
+  other.points.resize(21);
+  other.hex8 = {0, 1, 3, 2, 4, 5, 6, 6};
+  EXPECT_THROW(io::XdmfResultWriter::reopen(two, other, kept), std::runtime_error);
+  kept.resize(6, kept.back());
+  EXPECT_THROW(io::XdmfResultWriter::reopen(two, mesh, kept), std::runtime_error);
+  fs::remove_all(one);
+  fs::remove_all(two);
 }

@@ -12,11 +12,11 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <sstream>
 
 #include "fem/checkpoint.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/hdf5_checkpoint.hpp"
-#include "fem/io/result_reader.hpp"
 #include "fem/io/result_writers.hpp"
 #include "fem/solver.hpp"
 #include "workflow/figures/figures.hpp"
@@ -56,71 +56,49 @@ class FrameOutput {
     w.write_int("frame_errors", static_cast<std::int64_t>(errors_));
     fem::save_array(w, "frame_time", times_);
     fem::save_array(w, "frame_cycle", cycles_);
+    std::string fields;
+    if (xdmf_)
+      for (const auto& fr : xdmf_->written_frames()) {
+        for (std::size_t i = 0; i < fr.fields.size(); ++i)
+          fields += (i ? ";" : "") + fr.fields[i].name + "," + (fr.fields[i].on_cells ? "1" : "0") +
+                    "," + std::to_string(fr.fields[i].n_components);
+        fields += '\n';
+      }
+    w.write_string("frame_fields", fields);
   }
-  /// The frames written up to the checkpoint are kept (results.h5 is written again with them:
-  /// frames written after the checkpoint go), .vtu frames after them are removed.
-  void load_state(fem::CheckpointReader& r, const fem::ExplicitSolver& s,
-                  const MeasureList& measures) {
+  /// The frames written up to the checkpoint are kept where they are; those written after it
+  /// go (their results.h5 groups, their .vtu files).
+  void load_state(fem::CheckpointReader& r, const fem::ExplicitSolver& s) {
     written_ = static_cast<std::size_t>(r.read_int("frames_written"));
     errors_ = static_cast<std::size_t>(r.read_int("frame_errors"));
     r.read_array("frame_time", times_, written_);
     r.read_array("frame_cycle", cycles_, written_);
     if (!settings_.xdmf && !settings_.vtu) return;
     const fem::io::ResultMesh mesh = result_mesh(s);
-    namespace fs = std::filesystem;
     if (settings_.xdmf) {
-      const fs::path h5 = dir_ / "results.h5", old = dir_ / "results.h5.resume";
-      std::error_code ec;
-      // results.h5.resume left by a resume that failed holds the frames: it is kept.
-      if (fs::exists(old, ec))
-        fs::remove(h5, ec);
-      else if (fs::exists(h5, ec))
-        fs::rename(h5, old);
-      if (written_ > 0 && !fs::exists(old, ec))
-        throw InputError(h5.string(), "--resume",
-                         "is missing: the frames before the checkpoint are gone");
-      xdmf_ = std::make_unique<fem::io::XdmfResultWriter>(dir_, mesh);
-      // The fields in the order the run writes them (results.xdmf comes out the same).
-      std::vector<std::string> order;
-      {
-        const fem::io::Frame f0 = make_frame(s);
-        for (const auto& f : f0.fields) order.push_back(f.name);
-        std::vector<fem::MeasureCellField> extra;
-        for (const auto& m : measures) m->add_frame_fields(s, extra);
-        for (const auto& f : extra) order.push_back(f.name);
-      }
-      const auto rank = [&](const std::string& name) {
-        return std::find(order.begin(), order.end(), name) - order.begin();
-      };
-      if (written_ > 0) {
-        try {
-          const fem::io::ResultReader in(old);
-          if (in.n_frames() < written_)
-            throw std::runtime_error("holds " + std::to_string(in.n_frames()) + " frames, the " +
-                                     "checkpoint " + std::to_string(written_));
-          for (std::size_t k = 0; k < written_; ++k) {
-            fem::io::StoredFrame sf = in.frame(k);
-            fem::io::Frame fr;
-            fr.time = sf.time;
-            fr.cycle = sf.cycle;
-            for (auto& f : sf.fields) {
-              if (!f.on_cells && f.name == "displacement")
-                fr.displacement = std::move(f.values);
-              else
-                fr.fields.push_back(std::move(f));
-            }
-            std::stable_sort(fr.fields.begin(), fr.fields.end(), [&](const auto& a, const auto& b) {
-              return rank(a.name) < rank(b.name);
-            });
-            xdmf_->write_frame(fr);
-          }
-        } catch (const std::runtime_error& e) {
-          throw InputError(h5.string(), "--resume",
-                           std::string("the frames before the checkpoint cannot be read back (") +
-                               e.what() + ")");
+      // The frames' fields as results.xdmf listed them: "name,cells,components;..." per line.
+      std::vector<fem::io::WrittenFrame> kept(written_);
+      std::stringstream lines(r.read_string("frame_fields"));
+      std::string line;
+      for (std::size_t k = 0; k < written_; ++k) {
+        kept[k].time = times_[k];
+        kept[k].cycle = static_cast<int>(cycles_[k]);
+        if (!std::getline(lines, line)) r.mismatch("frame_fields", "lists fewer frames");
+        std::stringstream fields(line);
+        for (std::string f; std::getline(fields, f, ';');) {
+          const auto c1 = f.find(','), c2 = f.rfind(',');
+          if (c1 == std::string::npos || c2 == c1) r.mismatch("frame_fields", "cannot be read");
+          kept[k].fields.push_back(
+              {f.substr(0, c1), f.substr(c1 + 1, c2 - c1 - 1) == "1", std::stoi(f.substr(c2 + 1))});
         }
       }
-      fs::remove(old, ec);
+      try {
+        xdmf_ = std::make_unique<fem::io::XdmfResultWriter>(
+            fem::io::XdmfResultWriter::reopen(dir_, mesh, kept));
+      } catch (const std::runtime_error& e) {
+        throw InputError((dir_ / "results.h5").string(), "--resume",
+                         std::string("cannot be continued: ") + e.what());
+      }
     }
     if (settings_.vtu) {
       vtu_ = std::make_unique<fem::io::VtuSeriesWriter>(dir_, mesh);
@@ -343,7 +321,7 @@ void load_checkpoint(Run& r, fem::CheckpointTree& t, fem::ExplicitSolver& s, Mea
     r.ke_ie_max = t.read_double("ke_ie_max");
     r.ke_ie_exceeded = t.read_int("ke_ie_exceeded") != 0;
     history.load_state(t);
-    frames.load_state(t, s, measures);
+    frames.load_state(t, s);
     // The summary as it stood, under this run's header (version, overrides, options).
     json saved = json::parse(t.read_string("summary"), nullptr, false);
     if (saved.is_object()) {
