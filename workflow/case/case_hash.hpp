@@ -4,7 +4,10 @@
 #include <toml++/toml.h>
 #include <vtksys/MD5.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,6 +27,28 @@ class Md5 {
                      static_cast<int>(len.size()));
     vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(s.data()),
                      static_cast<int>(s.size()));
+  }
+  /// The bytes of a file, as add() of its content would take them, read in pieces (an upstream
+  /// results.h5 may be gigabytes). False when it cannot be read.
+  bool add_file(const std::filesystem::path& file) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(file, ec);
+    std::ifstream in(file, std::ios::binary);
+    if (ec || !in) return false;
+    const std::string len = std::to_string(size) + ":";
+    vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(len.data()),
+                     static_cast<int>(len.size()));
+    std::vector<char> buf(1 << 20);
+    std::uintmax_t left = size;
+    while (left > 0 && in) {
+      in.read(buf.data(), static_cast<std::streamsize>(std::min<std::uintmax_t>(buf.size(), left)));
+      const auto got = static_cast<std::uintmax_t>(in.gcount());
+      if (got == 0) break;
+      vtksysMD5_Append(h_, reinterpret_cast<const unsigned char*>(buf.data()),
+                       static_cast<int>(got));
+      left -= got;
+    }
+    return left == 0;
   }
   std::string hex() {
     char out[33] = {};

@@ -48,7 +48,7 @@ std::string checkpoint_case_hash(const fs::path& case_file,
     const fs::path f = fs::path(value).is_absolute() ? fs::path(value) : dir / value;
     if (!fs::is_regular_file(f, ec)) continue;
     md5.add(key);
-    md5.add(read_file(f));
+    if (!md5.add_file(f)) md5.add("");
   }
   return md5.hex();
 }
