@@ -39,6 +39,16 @@ std::string ring_csv_with_kinematic(const std::vector<RingSample>& ring, const s
   return csv;
 }
 
+// The kinematic drape's quadrant maxima for the log (when the spec has one).
+void add_kinematic_line(const RingShearProbe& spec, std::vector<std::string>& lines) {
+  if (spec.kinematic.empty()) return;
+  const auto q = quadrant_maxima(spec.kinematic);
+  lines.push_back(fmt::format(
+      "ring shear, kinematic drape of {}: max q1 {:.2f}, q2 {:.2f}, q3 {:.2f}, q4 {:.2f} deg",
+      spec.kinematic_case, q.max_shear_deg[0], q.max_shear_deg[1], q.max_shear_deg[2],
+      q.max_shear_deg[3]));
+}
+
 void add_ring_summary(const std::vector<RingSample>& ring, const std::string& prefix,
                       const RingShearProbe& spec, nlohmann::json& summary) {
   const auto q = quadrant_maxima(ring);
@@ -54,7 +64,6 @@ void add_ring_summary(const std::vector<RingSample>& ring, const std::string& pr
 
 }  // namespace
 
-
 RingShearMeasure::RingShearMeasure(const RingShearProbe& spec, const fem::ExplicitSolver& s)
     : spec_(spec), plies_(s, spec.part_a, spec.part_b) {
   std::vector<std::int32_t> all(plies_.conn.size());
@@ -68,13 +77,7 @@ std::vector<std::string> RingShearMeasure::setup_lines() const {
   std::vector<std::string> lines{fmt::format(
       "ring shear: {} + {} tow elements, {} outer-face triangles, ring {:.4g} m above the plane",
       plies_.n_a, plies_.elements.size() - plies_.n_a, faces_.size(), spec_.ring.height)};
-  if (!spec_.kinematic.empty()) {
-    const auto q = quadrant_maxima(spec_.kinematic);
-    lines.push_back(fmt::format(
-        "ring shear, kinematic drape of {}: max q1 {:.2f}, q2 {:.2f}, q3 {:.2f}, q4 {:.2f} deg",
-        spec_.kinematic_case, q.max_shear_deg[0], q.max_shear_deg[1], q.max_shear_deg[2],
-        q.max_shear_deg[3]));
-  }
+  add_kinematic_line(spec_, lines);
   return lines;
 }
 
@@ -129,13 +132,7 @@ std::vector<std::string> ShellRingShearMeasure::setup_lines() const {
   std::vector<std::string> lines{
       fmt::format("ring shear (macro): {} shells, ring {:.4g} m above the plane", n_shells_,
                   spec_.ring.height)};
-  if (!spec_.kinematic.empty()) {
-    const auto q = quadrant_maxima(spec_.kinematic);
-    lines.push_back(fmt::format(
-        "ring shear, kinematic drape of {}: max q1 {:.2f}, q2 {:.2f}, q3 {:.2f}, q4 {:.2f} deg",
-        spec_.kinematic_case, q.max_shear_deg[0], q.max_shear_deg[1], q.max_shear_deg[2],
-        q.max_shear_deg[3]));
-  }
+  add_kinematic_line(spec_, lines);
   return lines;
 }
 
@@ -169,8 +166,8 @@ void ShellRingShearMeasure::add_summary(const fem::ExplicitSolver& s,
   add_ring_summary(ring(s), "macro_", spec_, summary);
 }
 
-std::vector<std::string> ShellRingShearMeasure::write_files(const fem::ExplicitSolver& s,
-                                                            const std::filesystem::path& dir) const {
+std::vector<std::string> ShellRingShearMeasure::write_files(
+    const fem::ExplicitSolver& s, const std::filesystem::path& dir) const {
   fem::io::atomic_write_text(dir / "ring_shear.csv",
                              ring_csv_with_kinematic(ring(s), "macro_shear_deg", spec_));
   return {"ring_shear.csv"};

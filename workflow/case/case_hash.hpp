@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -73,6 +74,21 @@ inline void string_values(const toml::node& n, const std::string& path,
   } else if (const auto* s = n.as_string()) {
     out.emplace_back(path, s->get());
   }
+}
+
+/// The resolved case (`root`: a CaseDocument's, with its base, includes and overrides) as the text
+/// the hashes cover, less the run-control keys that do not change what a completed run holds
+/// (time.max_cycles, output.checkpoint_*): a stage stopped by its cycle limit resumes with the
+/// same hash.
+inline std::string hashed_case_text(toml::table root) {
+  if (auto* t = root["time"].as_table()) t->erase("max_cycles");
+  if (auto* o = root["output"].as_table()) {
+    o->erase("checkpoint_interval");
+    o->erase("checkpoint_every_cycles");
+  }
+  std::ostringstream resolved;
+  resolved << root;
+  return resolved.str();
 }
 
 }  // namespace ncfsim::workflow

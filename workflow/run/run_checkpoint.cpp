@@ -28,19 +28,11 @@ std::string join(const std::vector<std::string>& v, const char* sep) {
 std::string checkpoint_case_hash(const fs::path& case_file,
                                  const std::vector<std::string>& overrides) {
   const fem::CaseDocument doc = fem::CaseDocument::load(case_file, overrides);
-  toml::table root = doc.root();
-  if (auto* t = root["time"].as_table()) t->erase("max_cycles");
-  if (auto* o = root["output"].as_table()) {
-    o->erase("checkpoint_interval");
-    o->erase("checkpoint_every_cycles");
-  }
-  std::ostringstream resolved;
-  resolved << root;
   Md5 md5;
   md5.add(kVersion);
-  md5.add(resolved.str());
+  md5.add(hashed_case_text(doc.root()));
   std::vector<std::pair<std::string, std::string>> strings;
-  string_values(root, "", strings);
+  string_values(doc.root(), "", strings);
   const fs::path dir = case_file.parent_path();
   for (const auto& [key, value] : strings) {
     if (value.empty() || value.size() > 4096) continue;

@@ -46,19 +46,9 @@ struct StagePlan {
 // The stage's inputs and their hash; the upstream hashes are those of plans already made.
 void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream_hash) {
   const fem::CaseDocument doc = fem::CaseDocument::load(p.spec.case_file, p.overrides);
-  // Less the keys that do not change what a completed stage holds (a stage stopped by its cycle
-  // limit is resumed with the same hash: checkpoint_case_hash leaves out the same keys).
-  toml::table root = doc.root();
-  if (auto* t = root["time"].as_table()) t->erase("max_cycles");
-  if (auto* o = root["output"].as_table()) {
-    o->erase("checkpoint_interval");
-    o->erase("checkpoint_every_cycles");
-  }
-  std::ostringstream resolved;
-  resolved << root;
   Md5 md5;
   md5.add(kVersion);
-  md5.add(resolved.str());
+  md5.add(hashed_case_text(doc.root()));
   std::set<std::string> input_keys;
   for (const auto& [key, up] : p.spec.inputs) input_keys.insert(key);
   std::vector<std::pair<std::string, std::string>> strings;
