@@ -66,7 +66,7 @@ struct Shell4Block {
   std::vector<double> shear_force;   // [2][n] transverse shear force Q (N/m)
   std::vector<double> hg_force;      // [5][n] hourglass generalised forces (x, y, w, wx, wy)
   std::vector<double> drill_moment;  // [4][n] drilling spring moment at each corner (N m)
-  std::vector<double> polar_angle;   // [n][2] cos, sin of the polar rotation of F last cycle
+  std::vector<double> polar_angle;   // [2][n] cos, sin of the polar rotation of F last cycle
   std::vector<double> history;       // [n_history][n] of the membrane law
 
   // Stiffnesses of the section per unit width.

@@ -102,34 +102,12 @@ class Shell4Group final : public ElementGroup {
   const std::vector<double>& rotation_velocity() const { return omega_; }
 
   void save_state(CheckpointWriter& w) const override {
-    save_array(w, "strain", block.strain);
-    save_array(w, "curvature", block.curvature);
-    save_array(w, "shear", block.shear);
-    save_array(w, "resultant", block.resultant);
-    save_array(w, "moment", block.moment);
-    save_array(w, "shear_force", block.shear_force);
-    save_array(w, "hg_force", block.hg_force);
-    save_array(w, "drill_moment", block.drill_moment);
-    save_array(w, "polar_angle", block.polar_angle);
-    save_array(w, "history", block.history);
-    save_array(w, "rotation_velocity", omega_);
-    save_array(w, "nodal_moment", moment_);
+    for_each_state_array(*this, [&](const char* name, const auto& v) { save_array(w, name, v); });
     w.write_double("dt_last", dt_last_);
     w.write_double("rotational_kinetic", ke_rot_);
   }
   void load_state(CheckpointReader& r) override {
-    load_array(r, "strain", block.strain);
-    load_array(r, "curvature", block.curvature);
-    load_array(r, "shear", block.shear);
-    load_array(r, "resultant", block.resultant);
-    load_array(r, "moment", block.moment);
-    load_array(r, "shear_force", block.shear_force);
-    load_array(r, "hg_force", block.hg_force);
-    load_array(r, "drill_moment", block.drill_moment);
-    load_array(r, "polar_angle", block.polar_angle);
-    load_array(r, "history", block.history);
-    load_array(r, "rotation_velocity", omega_);
-    load_array(r, "nodal_moment", moment_);
+    for_each_state_array(*this, [&](const char* name, auto& v) { load_array(r, name, v); });
     dt_last_ = r.read_double("dt_last");
     ke_rot_ = r.read_double("rotational_kinetic");
   }
@@ -139,6 +117,17 @@ class Shell4Group final : public ElementGroup {
   std::vector<std::uint8_t> fixed_;               // [3 n] rotation held at zero
   std::vector<std::int32_t> nodes_;               // the group's nodes
   double dt_last_ = 0, ke_rot_ = 0;
+
+  // The arrays a checkpoint holds, by name: save and load walk the same list.
+  template <class Group, class Fn>
+  static void for_each_state_array(Group& g, Fn&& fn) {
+    auto& b = g.block;
+    fn("strain", b.strain), fn("curvature", b.curvature), fn("shear", b.shear);
+    fn("resultant", b.resultant), fn("moment", b.moment), fn("shear_force", b.shear_force);
+    fn("hg_force", b.hg_force), fn("drill_moment", b.drill_moment);
+    fn("polar_angle", b.polar_angle), fn("history", b.history);
+    fn("rotation_velocity", g.omega_), fn("nodal_moment", g.moment_);
+  }
 };
 
 // E and nu of an isotropic elastic material from its stiffness, or false.
