@@ -102,6 +102,20 @@ void require_hits(const std::vector<drape::RingSample>& ring, const fs::path& fi
                                spec.height, how, height_span(pts, spec)));
 }
 
+// The ring of a point cloud (a CSV, or a .vtu without surfaces): the search tolerance (given, or
+// from the cloud's spacing), the ring, and at least one azimuth that meets the data.
+void ring_of_cloud(ImportedRing& out, const std::vector<V3>& pts, const std::vector<double>& values,
+                   const fs::path& file, const RingImportOptions& opt) {
+  out.tolerance = opt.tolerance > 0 ? opt.tolerance : auto_tolerance(pts);
+  if (!(out.tolerance > 0))
+    throw InputError(
+        file.string(), "",
+        "fewer than two distinct points: no spacing to search the ring by (give --tolerance, m)");
+  out.ring = ring_from_points(pts, values, opt.ring, out.tolerance);
+  require_hits(out.ring, file, pts, opt.ring,
+               fmt::format("no point within {:.3g} m of a ray", out.tolerance));
+}
+
 // ---------------------------------------------------------------------------------------------
 // CSV
 
@@ -185,14 +199,7 @@ ImportedRing import_csv(const fs::path& file, const RingImportOptions& opt) {
   if (std::none_of(val.begin(), val.end(), [](double v) { return std::isfinite(v); }))
     throw InputError(file.string(), "", "no finite shear angle in column '" + out.field + "'");
   out.points = pts.size();
-  out.tolerance = opt.tolerance > 0 ? opt.tolerance : auto_tolerance(pts);
-  if (!(out.tolerance > 0))
-    throw InputError(
-        file.string(), "",
-        "fewer than two distinct points: no spacing to search the ring by (give --tolerance, m)");
-  out.ring = ring_from_points(pts, val, opt.ring, out.tolerance);
-  require_hits(out.ring, file, pts, opt.ring,
-               fmt::format("no point within {:.3g} m of a ray", out.tolerance));
+  ring_of_cloud(out, pts, val, file, opt);
   return out;
 }
 
@@ -465,14 +472,7 @@ ImportedRing import_vtu(const fs::path& file, const RingImportOptions& opt) {
   if (std::none_of(node_value.begin(), node_value.end(), [](double v) { return std::isfinite(v); }))
     throw InputError(file.string(), "", "no finite value in the field '" + f.name + "'");
   out.method = "points";
-  out.tolerance = opt.tolerance > 0 ? opt.tolerance : auto_tolerance(pts);
-  if (!(out.tolerance > 0))
-    throw InputError(
-        file.string(), "",
-        "fewer than two distinct points: no spacing to search the ring by (give --tolerance, m)");
-  out.ring = ring_from_points(pts, node_value, opt.ring, out.tolerance);
-  require_hits(out.ring, file, pts, opt.ring,
-               fmt::format("no point within {:.3g} m of a ray", out.tolerance));
+  ring_of_cloud(out, pts, node_value, file, opt);
   return out;
 }
 
