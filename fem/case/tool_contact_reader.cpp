@@ -130,6 +130,25 @@ std::vector<std::int32_t> solid_and_shell_nodes(const Mesh& mesh) {
   return out;
 }
 
+// Shells touch a tool with their faces: the default contact offset is half the thickness of the
+// thickest shell holding one of the tool's contact nodes (0 for nodes of solids only: they touch
+// with their surface nodes).
+double half_shell_thickness(const Model& model, const std::vector<std::int32_t>& nodes) {
+  const ElementSet* shells = model.mesh.find_set(ElementKind::Quad4);
+  if (!shells) return 0.0;
+  std::vector<char> contact(model.mesh.n_nodes(), 0);
+  for (auto v : nodes) contact[static_cast<std::size_t>(v)] = 1;
+  double half = 0;
+  for (std::size_t e = 0; e < shells->size(); ++e)
+    for (auto v : shells->nodes(e))
+      if (contact[static_cast<std::size_t>(v)]) {
+        const auto p = static_cast<std::size_t>(shells->part[e]);
+        half = std::max(half, 0.5 * model.parts[p].shell_thickness);
+        break;
+      }
+  return half;
+}
+
 void read_tool(CaseReadContext& ctx, const TableReader& t) {
   RigidTool tool;
   tool.name = t.string("name");
@@ -138,16 +157,13 @@ void read_tool(CaseReadContext& ctx, const TableReader& t) {
   tool.friction = t.number("friction", 0.0, Range::non_negative());
   tool.penalty_scale = t.number("penalty_scale", 0.1, Range::open_closed(0, 1.0));
   tool.damping = t.number("damping", 0.1, Range::closed(0, 1.0));
-  // Shells touch a tool with their faces: by default the contact offset is half the thickest
-  // shell's thickness (0 without shells: solids touch with their surface nodes).
-  double half_shell = 0;
-  for (const auto& pp : ctx.model.parts) half_shell = std::max(half_shell, 0.5 * pp.shell_thickness);
-  tool.thickness = t.number("thickness", half_shell, Range::non_negative());
   tool.search_margin = t.number("search_margin", 0.0, Range::non_negative());
   tool.contact_nodes = t.has("contact_nodes") ? select_nodes(ctx, t, "contact_nodes")
                                               : solid_and_shell_nodes(ctx.model.mesh);
   if (tool.contact_nodes.empty())
     t.fail("contact_nodes", "missing, and the model has no solid or shell element to touch");
+  tool.thickness = t.number("thickness", half_shell_thickness(ctx.model, tool.contact_nodes),
+                            Range::non_negative());
   check_starts_clear(t, tool, ctx.model.mesh);
   if (tool.motion.kind == ToolMotion::Kind::Force && t.has("pressure")) {
     if (tool.surface.shape != ToolShape::Plane && tool.surface.shape != ToolShape::PlaneWithHole)
