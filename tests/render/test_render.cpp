@@ -2,6 +2,9 @@
 //
 // Every picture is read back with vtkPNGReader and measured; no reference images are stored.
 // The program unsets DISPLAY before any test runs, so a pass proves that no X server is involved.
+// CTest runs it once per back end (NCFSIM_RENDER_BACKEND = osmesa, egl; and auto falling back to
+// EGL when libOSMesa cannot be loaded), NCFSIM_RENDER_TEST_EXPECT naming the back end the context
+// must report.
 // Images are kept for a human to look at in $NCFSIM_RENDER_TEST_OUTPUT (set by CTest to
 // <build>/tests/render/render_test_output), else in the system temporary folder.
 #include "render.hpp"
@@ -19,6 +22,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -133,6 +137,10 @@ TEST(Render, OffscreenContextIsAvailable)
   ASSERT_TRUE(ok) << why;
   EXPECT_NE(why.find("OpenGL"), std::string::npos) << why;
   std::cout << "off-screen context: " << why << "\n";
+  if (const char* expect = std::getenv("NCFSIM_RENDER_TEST_EXPECT");
+      expect != nullptr && *expect != '\0') {
+    EXPECT_EQ(why.rfind(expect, 0), 0u) << "expected the back end '" << expect << "', got " << why;
+  }
 }
 
 // 10 x 10 x 1 slab, linear cell field in x, camera Top, 1200 x 900.
@@ -327,6 +335,142 @@ TEST(Render, CurvePlotShowsSeriesColours)
   EXPECT_GT(colours.size(), 50u);
   EXPECT_GT(share_foreground, 0.03);
   EXPECT_LT(share_foreground, 0.30);
+}
+
+namespace {
+
+// Per-channel (R, G, B) mean and standard deviation of an image, in 0..255.
+struct ChannelStats {
+  std::array<double, 3> mean{}, stddev{};
+};
+
+ChannelStats channel_stats(const Image& img) {
+  std::array<double, 3> sum{}, sum_sq{};
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const Rgb c = img.at(x, y);
+      const double v[3] = {double(c.r), double(c.g), double(c.b)};
+      for (int k = 0; k < 3; ++k) {
+        sum[k] += v[k];
+        sum_sq[k] += v[k] * v[k];
+      }
+    }
+  }
+  ChannelStats s;
+  const double n = double(img.width) * img.height;
+  for (int k = 0; k < 3; ++k) {
+    s.mean[k] = sum[k] / n;
+    s.stddev[k] = std::sqrt(std::max(0.0, sum_sq[k] / n - s.mean[k] * s.mean[k]));
+  }
+  return s;
+}
+
+// Back to NCFSIM_RENDER_BACKEND when a test that chose a back end ends, however it ends.
+struct BackendOverride {
+  explicit BackendOverride(RenderBackend b) { set_render_backend(b); }
+  ~BackendOverride() { set_render_backend(std::nullopt); }
+  BackendOverride(const BackendOverride&) = delete;
+  BackendOverride& operator=(const BackendOverride&) = delete;
+};
+
+}  // namespace
+
+// The same mesh figure and curve plot drawn by OSMesa and by EGL in one process are the same
+// picture: per-channel mean and standard deviation within 0.5 (of 255), and under 0.5 % of the
+// pixels differ. Both back ends are Mesa's llvmpipe behind the same VTK path; measured on Mesa
+// 22.3.6: byte-identical PNGs. Auto picks OSMesa when it is installed (scripts/setup installs it).
+TEST(Render, OSMesaAndEglDrawTheSamePicture) {
+  {
+    BackendOverride choose(RenderBackend::Auto);
+    std::string why;
+    ASSERT_TRUE(offscreen_rendering_available(&why)) << why;
+    EXPECT_EQ(why.rfind("OSMesa: ", 0), 0u) << why;
+  }
+  MeshFigure figure;
+  figure.field = "velocity";
+  figure.title = "6 x 4 x 1 slab, velocity magnitude";
+  figure.camera = CameraPreset::Iso;
+  figure.width = 800;
+  figure.height = 600;
+  CurvePlot plot;
+  plot.title = "two curves";
+  plot.x_label = "x [mm]";
+  plot.y_label = "y [N]";
+  plot.series = {{"rising", {0.0, 1.0, 2.0, 3.0}, {0.0, 1.0, 4.0, 9.0}, false, false},
+                 {"falling", {0.0, 1.0, 2.0, 3.0}, {9.0, 5.0, 2.0, 0.0}, true, false}};
+  plot.width = 800;
+  plot.height = 600;
+
+  const std::pair<RenderBackend, const char*> backends[2] = {{RenderBackend::OSMesa, "osmesa"},
+                                                             {RenderBackend::Egl, "egl"}};
+  for (const char* scene : {"mesh", "plot"}) {
+    Image img[2];
+    for (int b = 0; b < 2; ++b) {
+      BackendOverride choose(backends[b].first);
+      std::string why;
+      ASSERT_TRUE(offscreen_rendering_available(&why)) << backends[b].second << ": " << why;
+      EXPECT_EQ(why.rfind(b == 0 ? "OSMesa: " : "EGL: ", 0), 0u) << why;
+      const fs::path png =
+          output_dir() / (std::string("backend_") + backends[b].second + "_" + scene + ".png");
+      if (std::string(scene) == "mesh") {
+        ASSERT_NO_THROW(render_mesh_png(slab(6, 4), figure, png)) << backends[b].second;
+      } else {
+        ASSERT_NO_THROW(plot_curves_png(plot, png)) << backends[b].second;
+      }
+      img[b] = read_png(png);
+      ASSERT_EQ(img[b].width, 800);
+      ASSERT_EQ(img[b].height, 600);
+    }
+    const ChannelStats os = channel_stats(img[0]), egl = channel_stats(img[1]);
+    long n_differ = 0;
+    for (int y = 0; y < 600; ++y) {
+      for (int x = 0; x < 800; ++x) {
+        const Rgb a = img[0].at(x, y), c = img[1].at(x, y);
+        n_differ += (a.r != c.r || a.g != c.g || a.b != c.b) ? 1 : 0;
+      }
+    }
+    std::cout << scene << ": mean RGB OSMesa " << os.mean[0] << " " << os.mean[1] << " "
+              << os.mean[2] << ", EGL " << egl.mean[0] << " " << egl.mean[1] << " " << egl.mean[2]
+              << "; std OSMesa " << os.stddev[0] << " " << os.stddev[1] << " " << os.stddev[2]
+              << ", EGL " << egl.stddev[0] << " " << egl.stddev[1] << " " << egl.stddev[2]
+              << "; pixels that differ " << n_differ << "\n";
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(os.mean[k], egl.mean[k], 0.5) << scene << " channel " << k;
+      EXPECT_NEAR(os.stddev[k], egl.stddev[k], 0.5) << scene << " channel " << k;
+    }
+    // Not a blank picture on either side.
+    EXPECT_GT(os.stddev[0], 10.0) << scene;
+    EXPECT_LT(n_differ, 0.005 * 800 * 600) << scene;
+  }
+}
+
+// A back end name the program does not know is an error naming the variable, not a silent
+// default.
+TEST(Render, UnknownBackendNamesTheVariable) {
+  const char* old = std::getenv("NCFSIM_RENDER_BACKEND");
+  const std::optional<std::string> saved =
+      old != nullptr ? std::optional<std::string>(old) : std::nullopt;
+  set_render_backend(std::nullopt);
+  ::setenv("NCFSIM_RENDER_BACKEND", "vulkan", 1);
+  std::string why;
+  const bool ok = offscreen_rendering_available(&why);
+  MeshFigure figure;
+  figure.field = "temperature";
+  bool threw = false;
+  try {
+    render_mesh_png(slab(2, 2), figure, output_dir() / "never_written.png");
+  } catch (const std::runtime_error& e) {
+    threw = std::string(e.what()).find("NCFSIM_RENDER_BACKEND='vulkan'") != std::string::npos;
+  }
+  if (saved) {
+    ::setenv("NCFSIM_RENDER_BACKEND", saved->c_str(), 1);
+  } else {
+    ::unsetenv("NCFSIM_RENDER_BACKEND");
+  }
+  EXPECT_FALSE(ok);
+  EXPECT_NE(why.find("NCFSIM_RENDER_BACKEND='vulkan'"), std::string::npos) << why;
+  EXPECT_TRUE(threw);
+  EXPECT_FALSE(fs::exists(output_dir() / "never_written.png"));
 }
 
 TEST(Render, UnknownFieldThrowsWithTheNames)

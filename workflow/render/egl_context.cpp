@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "gl_forward.hpp"
+
 // Not in <GL/gl.h> on every system; the values are fixed by the OpenGL specification.
 #ifndef GL_VENDOR
 #define GL_VENDOR 0x1F00
@@ -42,7 +44,8 @@ std::string egl_error_name(EGLint code)
 
 [[noreturn]] void fail(const std::string& what)
 {
-  throw std::runtime_error("off-screen rendering: " + what + " (" + egl_error_name(eglGetError()) +
+  throw std::runtime_error("off-screen rendering (EGL): " + what + " (" +
+                           egl_error_name(eglGetError()) +
                            "); needs Mesa EGL with the surfaceless platform (libegl-mesa0)");
 }
 
@@ -133,6 +136,15 @@ EglContext::EglContext(int width, int height)
     fail("eglMakeCurrent failed");
   }
 
+  try {
+    route_gl_calls(nullptr);
+  } catch (const std::exception& e) {
+    eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(display, context);
+    eglDestroySurface(display, surface);
+    throw std::runtime_error(std::string("off-screen rendering (EGL): ") + e.what());
+  }
+
   // glGetString through EGL's loader, so this file needs no OpenGL link of its own.
   using GetStringFn = const unsigned char* (*)(unsigned int);
   auto get_string = reinterpret_cast<GetStringFn>(eglGetProcAddress("glGetString"));
@@ -140,7 +152,7 @@ EglContext::EglContext(int width, int height)
     const unsigned char* s = get_string != nullptr ? get_string(name) : nullptr;
     return s != nullptr ? reinterpret_cast<const char*>(s) : "?";
   };
-  description_ = "OpenGL " + str(GL_VERSION) + ", renderer " + str(GL_RENDERER);
+  description_ = "EGL: OpenGL " + str(GL_VERSION) + ", renderer " + str(GL_RENDERER);
 }
 
 EglContext::~EglContext()

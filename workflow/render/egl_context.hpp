@@ -2,26 +2,21 @@
 // pbuffer surface, made current on the calling thread for the lifetime of the object.
 #pragma once
 
-#include <string>
+#include "gl_context.hpp"
 
 namespace ncfsim::render::detail {
 
-class EglContext {
+class EglContext final : public GlContext {
 public:
   // Creates the context and makes it current; throws std::runtime_error saying what failed.
+  // The executable's GL entry points call the system libGL (gl_forward.hpp).
   EglContext(int width, int height);
-  ~EglContext(); // releases (not current any more), destroys surface and context
-  EglContext(const EglContext&) = delete;
-  EglContext& operator=(const EglContext&) = delete;
-
-  // "OpenGL 4.5 (Core Profile) Mesa 22.3.6, renderer llvmpipe (...)"
-  const std::string& description() const { return description_; }
+  ~EglContext() override; // releases (not current any more), destroys surface and context
 
 private:
   void* display_ = nullptr; // EGLDisplay (initialised once per process, never terminated)
   void* surface_ = nullptr; // EGLSurface
   void* context_ = nullptr; // EGLContext
-  std::string description_;
 };
 
 } // namespace ncfsim::render::detail

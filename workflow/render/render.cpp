@@ -1,7 +1,8 @@
-// Off-screen figures with stock Debian VTK 9.1 on a Mesa EGL surfaceless context.
+// Off-screen figures with stock Debian VTK 9.1 on an OSMesa or a Mesa EGL surfaceless context.
 //
-// How it works (see /work/shared/rendering.md): EglContext makes a desktop-GL core context
-// current; vtkGenericOpenGLRenderWindow is told that it is current and renders into it; the
+// How it works (see /work/shared/rendering.md): make_gl_context makes a desktop-GL core context
+// current (OSMesa or EGL, gl_context.hpp; the executable's GL entry points send VTK's calls to it,
+// gl_forward.cpp); vtkGenericOpenGLRenderWindow is told that it is current and renders into it; the
 // pixels come back through vtkWindowToImageFilter and are PNG-encoded in memory, written to a
 // temporary file beside the destination and renamed over it. VTK calls glewInit, which the
 // executable overrides (glew_shim.cpp) so that Debian's GLX-only GLEW does not fail.
@@ -55,12 +56,13 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <system_error>
 #include <unordered_map>
 
-#include "egl_context.hpp"
+#include "gl_context.hpp"
 
 // Defined in glew_shim.cpp. Referencing the marker makes the linker pull the shim's object file
 // out of the static library into every executable that renders.
@@ -70,7 +72,8 @@ extern "C" int ncfsim_render_glew_shim_active(void);
 namespace ncfsim::render {
 namespace {
 
-// One render at a time per process: GLEW's function pointers and the EGL display are global.
+// One render at a time per process: GLEW's function pointers, the GL routing (gl_forward.cpp) and
+// the EGL display are global.
 std::mutex& render_mutex() {
   static std::mutex m;
   return m;
@@ -119,7 +122,7 @@ void check_shim(const std::string& where) {
   // Reading the marker keeps the reference alive under any optimisation level.
   if (ncfsim_render_glew_shim_marker != 1 || ncfsim_render_glew_shim_active() == 0) {
     fail(where,
-         "the glewInit shim is not the process-wide glewInit, so VTK would reject the EGL context "
+         "the glewInit shim is not the process-wide glewInit, so VTK would reject the context "
          "(GLEW_ERROR_NO_GLX_DISPLAY); build the executable with the CMake function "
          "ncfsim_enable_offscreen_rendering(<target>) (ENABLE_EXPORTS ON)");
   }
@@ -191,15 +194,15 @@ void write_png_atomically(vtkImageData* image, const std::filesystem::path& png,
   }
 }
 
-// An EGL context plus a VTK window that renders into it. Renderers are added by the caller;
+// An OpenGL context plus a VTK window that renders into it. Renderers are added by the caller;
 // capture() renders and returns a copy of the RGB pixels.
 class OffscreenWindow {
  public:
   OffscreenWindow(int width, int height, const std::string& where)
-      : where_(where), context_(width, height) {
+      : where_(where), context_(detail::make_gl_context(width, height)) {
     check_shim(where_);
     window_->SetSize(width, height);
-    window_->SetIsCurrent(true);  // EglContext made it current on this thread
+    window_->SetIsCurrent(true);  // make_gl_context made it current on this thread
     window_->SetReadyForRendering(true);
     window_->SetSupportsOpenGL(1);
     window_->SetIsDirect(1);
@@ -244,7 +247,7 @@ class OffscreenWindow {
 
  private:
   std::string where_;
-  detail::EglContext context_;  // declared before the VTK objects: destroyed after them
+  std::unique_ptr<detail::GlContext> context_;  // declared before the VTK objects: destroyed after
   VtkErrors errors_;
   vtkNew<vtkGenericOpenGLRenderWindow> window_;
 };
@@ -963,12 +966,12 @@ void plot_curves_png(const CurvePlot& plot, const std::filesystem::path& png) {
 bool offscreen_rendering_available(std::string* why) {
   try {
     std::lock_guard lock(render_mutex());
-    detail::EglContext context(16, 16);
+    const std::unique_ptr<detail::GlContext> context = detail::make_gl_context(16, 16);
     if (ncfsim_render_glew_shim_marker != 1 || ncfsim_render_glew_shim_active() == 0) {
       check_shim("offscreen_rendering_available");
     }
     if (why != nullptr) {
-      *why = context.description();
+      *why = context->description();
     }
     return true;
   } catch (const std::exception& e) {

@@ -1,13 +1,14 @@
 // ncfsim::render — off-screen figures: mesh pictures coloured by a field, and x-y curve plots.
 //
-// Plain-data inputs, no dependency on the rest of ncfsim. Rendering uses VTK on a Mesa EGL
-// surfaceless context (no X display needed, DISPLAY is never read). An executable that calls these
-// functions must be set up with the CMake function ncfsim_enable_offscreen_rendering(<target>)
-// (workflow/render/CMakeLists.txt), which links ncfsim_render and exports the glewInit shim.
+// Plain-data inputs, no dependency on the rest of ncfsim. Rendering uses VTK on an OSMesa context
+// or a Mesa EGL surfaceless context (RenderBackend; no X display needed, DISPLAY is never read).
+// An executable that calls these functions must be set up with the CMake function
+// ncfsim_enable_offscreen_rendering(<target>) (workflow/render/CMakeLists.txt), which links
+// ncfsim_render and exports the glewInit shim and the GL entry points that reach OSMesa.
 //
 // Every function that renders throws std::runtime_error with a readable message on any failure
-// (no EGL, bad input, unknown field, VTK error, PNG not writable). PNGs are written atomically:
-// a temporary file in the destination folder, then a rename.
+// (no OpenGL context, bad input, unknown field, VTK error, PNG not writable). PNGs are written
+// atomically: a temporary file in the destination folder, then a rename.
 #pragma once
 
 #include <array>
@@ -18,6 +19,24 @@
 #include <vector>
 
 namespace ncfsim::render {
+
+// Where the pictures are drawn; both are Mesa's llvmpipe software renderer, no GPU, no display.
+//   OSMesa: an OSMesa context rendering into memory (libOSMesa.so.8, loaded at run time);
+//   Egl:    a Mesa EGL surfaceless context with a pbuffer;
+//   Auto:   OSMesa, or EGL when no OSMesa context can be made (offscreen_rendering_available
+//           says which and why).
+// The choice: set_render_backend if called, else the environment variable
+// NCFSIM_RENDER_BACKEND = osmesa | egl | auto (unset or empty: auto; any other value: rendering
+// fails naming it).
+enum class RenderBackend { Auto, OSMesa, Egl };
+
+// Overrides NCFSIM_RENDER_BACKEND for the contexts this process makes from now on; std::nullopt
+// goes back to the variable.
+void set_render_backend(std::optional<RenderBackend> backend);
+
+// The back end asked for (set_render_backend, else NCFSIM_RENDER_BACKEND). Throws
+// std::runtime_error naming the variable when it holds something else than osmesa, egl or auto.
+RenderBackend requested_render_backend();
 
 // One field on a RenderMesh. values: [n_components * n_entities], component fastest, where the
 // entities are the points (on_cells = false) or the cells, hexes first, then bars, then shells
@@ -91,9 +110,11 @@ struct CurvePlot {
 
 void plot_curves_png(const CurvePlot& plot, const std::filesystem::path& png);
 
-// True when an off-screen OpenGL context can be created and VTK will accept it (EGL surfaceless
-// context, OpenGL >= 3.2 core, glewInit shim exported by the executable). Otherwise false and,
-// when why is given, the reason. Never throws.
+// True when an off-screen OpenGL context of the chosen back end can be created and VTK will accept
+// it (OpenGL >= 3.2 core, glewInit shim exported by the executable). Then why, when given, names
+// the back end and the driver ("OSMesa: OpenGL 4.5 (Core Profile) Mesa 22.3.6, renderer llvmpipe
+// (...)", "EGL: ...", or "EGL (fallback; <why OSMesa failed>): ..."): log it. Otherwise false and
+// the reason. Never throws.
 bool offscreen_rendering_available(std::string* why = nullptr);
 
 }  // namespace ncfsim::render
