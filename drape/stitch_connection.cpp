@@ -188,7 +188,7 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
   const double Fs = s_.sliding_force, Ft = s_.transverse_force;
   // Each hexahedron's axis and its turn from set-up, once.
   for (std::size_t h = 0; h < n_slots; ++h) {
-    if (slot_hex_[h] < 0) continue;  // eroded
+    if (slot_hex_[h] < 0 || (!slot_mine_.empty() && !slot_mine_[h])) continue;  // eroded, remote
     const std::int32_t* hx = &slot_nodes_[8 * h];
     const double* w = &slot_w_[8 * h];
     double u[3] = {0, 0, 0};
@@ -205,6 +205,7 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
       force_[i] = 0;
       continue;
     }
+    if (!joint_mine_.empty() && !joint_mine_[i]) continue;  // another rank's
     const auto h = static_cast<std::size_t>(joint_slot_[i]);
     const std::size_t a = static_cast<std::size_t>(a_[i]), b = static_cast<std::size_t>(b_[i]);
     const TowTurn R = load(&slot_t0_[3 * h], &slot_turn_[kTurnSize * h]);
@@ -252,7 +253,7 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
   // The forces of the energy k |d|^2 / 2 through the turn of the rest offsets with each
   // hexahedron's axis u: w_I g on its nodes, g summed over its joints.
   for (std::size_t h = 0; h < n_slots; ++h) {
-    if (slot_hex_[h] < 0) continue;
+    if (slot_hex_[h] < 0 || (!slot_mine_.empty() && !slot_mine_[h])) continue;
     const TowTurn R = load(&slot_t0_[3 * h], &slot_turn_[kTurnSize * h]);
     double g[3];
     R.adjoint(&slot_m_[9 * h], g);
@@ -265,6 +266,28 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
   dissipated_ += diss;
   n_sliding_ = sliding;
   total_ = total;
+}
+
+bool StitchToTowConnection::nodes_to_read(const std::uint8_t* owned, const double*, double,
+                                          std::vector<std::int32_t>& out) const {
+  for (std::size_t i = 0; i < a_.size(); ++i) {
+    if (!owned[static_cast<std::size_t>(a_[i])]) continue;
+    out.push_back(b_[i]);
+    if (joint_slot_[i] >= 0) {
+      const auto h = static_cast<std::size_t>(joint_slot_[i]);
+      out.insert(out.end(), &slot_nodes_[8 * h], &slot_nodes_[8 * h] + 8);
+    }
+  }
+  return true;
+}
+
+void StitchToTowConnection::restrict_to_rank(const std::uint8_t* owned, const std::uint8_t*) {
+  joint_mine_.assign(a_.size(), 0);
+  slot_mine_.assign(slot_hex_.size(), 0);
+  for (std::size_t i = 0; i < a_.size(); ++i) {
+    joint_mine_[i] = owned[static_cast<std::size_t>(a_[i])];
+    if (joint_mine_[i] && joint_slot_[i] >= 0) slot_mine_[static_cast<std::size_t>(joint_slot_[i])] = 1;
+  }
 }
 
 void StitchToTowConnection::erode(const std::vector<std::int32_t>& mesh_elements) {

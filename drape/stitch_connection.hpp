@@ -38,6 +38,11 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   /// A joint whose axis hexahedron (one holding its tow node and axis node) is eroded is
   /// released: that piece of tow is gone and gives no axis.
   void erode(const std::vector<std::int32_t>& mesh_elements) override;
+  /// Several ranks: a joint is computed where its stitch node is owned; it reads the tow node
+  /// and the hexahedron that gives the tow's axis.
+  bool nodes_to_read(const std::uint8_t* owned, const double* x0, double halo,
+                     std::vector<std::int32_t>& out) const override;
+  void restrict_to_rank(const std::uint8_t* owned, const std::uint8_t* readable) override;
   void save_state(fem::CheckpointWriter& w) const override;
   void load_state(fem::CheckpointReader& r) override;
   /// Joints released by erosion so far.
@@ -63,6 +68,9 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   // The tow hexahedra that give the joints' axes, each once (about 8 joints share one on the bias
   // cases' CI mesh): its axis is gathered and its forces scattered once per cycle. Per joint: its
   // hexahedron's slot (-1: released by erosion).
+  // Several ranks (empty on one): [n] 1: the joint is computed here; [n_slots] 1: a joint of
+  // this rank uses the slot.
+  std::vector<std::uint8_t> joint_mine_, slot_mine_;
   std::vector<std::int32_t> joint_slot_;
   std::vector<std::int32_t> slot_hex_;    // [n_slots] mesh hexahedron (-1: eroded)
   std::vector<std::int32_t> slot_nodes_;  // [8*n_slots]

@@ -53,6 +53,22 @@ class ContactAlgorithm {
   /// index in its set) were eroded: their faces stop being contact segments from the next
   /// add_forces on, and the faces of their neighbours that they covered start being ones.
   virtual void erode(const std::vector<std::int32_t>& mesh_elements) { (void)mesh_elements; }
+  // Domain decomposition (fem/parallel/domain.hpp, docs/parallel.md).
+  /// Appends the nodes this rank must read, beyond the elements it integrates, to compute the
+  /// contacts of the nodes it owns (owned[mesh node] = 1) at reference positions x0, remote
+  /// surfaces within `halo` (m) of its own included. False: this contact cannot run on several
+  /// ranks.
+  virtual bool nodes_to_read(const std::uint8_t* owned, const double* x0, double halo,
+                             std::vector<std::int32_t>& out) const {
+    (void)owned, (void)x0, (void)halo, (void)out;
+    return false;
+  }
+  /// From now on computes only the contacts of the nodes this rank owns, with the nodes it can
+  /// read (readable[mesh node] = 1, kept current by the ghost exchange). Its resultants,
+  /// dissipation and counters are then this rank's share.
+  virtual void restrict_to_rank(const std::uint8_t* owned, const std::uint8_t* readable) {
+    (void)owned, (void)readable;
+  }
   /// The contact's state carried from cycle to cycle into a checkpoint, and back into a contact
   /// built and initialised from the same case (fem/checkpoint.hpp; CheckpointMismatch when it
   /// does not fit). Called at a cycle boundary only.

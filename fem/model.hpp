@@ -80,6 +80,14 @@ struct TimeControl {
                                     // share of the initial one (LS-DYNA's ERODE with DTMIN)
 };
 
+// Runs on several MPI ranks (docs/parallel.md).
+struct ParallelControl {
+  // How far from its own surface nodes a rank keeps the remote contact segments (the contact
+  // halo, fixed at the start): surfaces that slide further than this relative to each other
+  // across a partition boundary during the run are not seen, m.
+  double contact_halo = 0.01;
+};
+
 struct Model {
   Mesh mesh;
   std::vector<std::unique_ptr<SolidMaterial>> materials;
@@ -98,6 +106,7 @@ struct Model {
   std::vector<RigidTool> tools;
   std::vector<std::unique_ptr<ContactAlgorithm>> contacts;  // deformable / tied contacts
   TimeControl time;
+  ParallelControl parallel;
 };
 
 }  // namespace ncfsim::fem

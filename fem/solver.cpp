@@ -4,12 +4,14 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <sstream>
 #include <utility>
 
 #include "fem/boundary/picture_frame_motion.hpp"
 #include "fem/checkpoint.hpp"
 #include "fem/errors.hpp"
+#include "fem/parallel/domain.hpp"
 
 namespace ncfsim::fem {
 
@@ -75,6 +77,57 @@ constexpr std::array<NodeUpdate, sizeof...(I)> node_update_table(std::index_sequ
 }
 constexpr auto kNodeUpdates = node_update_table(std::make_index_sequence<16>{});
 
+// The node update over a rank's runs of owned nodes; the sums add up over the runs.
+NodeUpdateSums owned_node_update(NodeUpdate f, const std::vector<std::pair<std::size_t, std::size_t>>& runs,
+                                 double alpha, double dt_mid, double dt_new, const double* inv_m,
+                                 const double* mm, const double* fi, const double* fe,
+                                 const double* fcon, double* vel, double* fdamp, double* x) {
+  NodeUpdateSums s;
+  for (const auto& [b, e] : runs) {
+    const std::size_t d = 3 * b;
+    const NodeUpdateSums r = f(3 * (e - b), alpha, dt_mid, dt_new, inv_m + d, mm + d, fi + d,
+                               fe + d, fcon + d, vel + d, fdamp + d, x ? x + d : nullptr);
+    s.ext_old += r.ext_old, s.ext_new += r.ext_new, s.damp_old += r.damp_old;
+    s.damp_new += r.damp_new, s.con_old += r.con_old, s.con_new += r.con_new, s.ke += r.ke;
+  }
+  return s;
+}
+
+// The step of the next cycle, the smallest over the ranks, and the controlling element (the
+// smallest element step; ties to the lower user id, as on one rank within a group).
+void reduce_step(MPI_Comm comm, double& dt_new, StableStep& st) {
+  struct Packed {
+    double dt_new, dt, element, kind;
+  };
+  static MPI_Op op = [] {
+    MPI_Op o;
+    MPI_Op_create(
+        [](void* in, void* inout, int* len, MPI_Datatype*) {
+          auto* a = static_cast<Packed*>(in);
+          auto* b = static_cast<Packed*>(inout);
+          for (int i = 0; i < *len; ++i) {
+            b[i].dt_new = std::min(a[i].dt_new, b[i].dt_new);
+            if (a[i].dt < b[i].dt || (a[i].dt == b[i].dt && a[i].element < b[i].element))
+              b[i].dt = a[i].dt, b[i].element = a[i].element, b[i].kind = a[i].kind;
+          }
+        },
+        1, &o);
+    return o;
+  }();
+  static MPI_Datatype type = [] {
+    MPI_Datatype t;
+    MPI_Type_contiguous(4, MPI_DOUBLE, &t);
+    MPI_Type_commit(&t);
+    return t;
+  }();
+  Packed p{dt_new, st.dt, static_cast<double>(st.element), static_cast<double>(st.kind)};
+  MPI_Allreduce(MPI_IN_PLACE, &p, 1, type, op, comm);
+  dt_new = p.dt_new;
+  st.dt = p.dt;
+  st.element = static_cast<std::int64_t>(p.element);
+  st.kind = static_cast<ElementKind>(static_cast<int>(p.kind));
+}
+
 }  // namespace
 
 ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
@@ -126,6 +179,8 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
     inv_mass_.resize(3 * n);
     for (std::size_t d = 0; d < 3 * n; ++d) inv_mass_[d] = 1.0 / M[d];
   }
+
+  if (PetscSession::size() > 1) decompose();
 
   fixed_mask_.assign(3 * n, 0);
   for (const auto& fx : model_.fixed)
@@ -192,8 +247,121 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
       dt_ = std::min(dt_, c->stable_step_limit());
     }
   }
+  if (domain_) {
+    // What each rank's contacts read of the others, then the exchange that keeps it current.
+    auto X0 = x0.view();
+    std::vector<std::int32_t> extra;
+    for (auto& c : model_.contacts) {
+      extra.clear();
+      if (!c->nodes_to_read(domain_->owned_mask().data(), X0.data(), model_.parallel.contact_halo,
+                            extra))
+        throw InputError("", "contact." + c->name(),
+                         "this contact cannot run on several MPI ranks yet: run it with --np 1");
+      domain_->add_readable(extra);
+    }
+    domain_->finalise();
+    for (auto& c : model_.contacts)
+      c->restrict_to_rank(domain_->owned_mask().data(), domain_->readable_mask().data());
+  }
   dt_initial_ = dt_;
   vpres_.resize(model_.velocities.size());
+}
+
+ExplicitSolver::~ExplicitSolver() = default;
+
+void ExplicitSolver::decompose() {
+  const auto refuse = [](const std::string& key, const std::string& what) {
+    throw InputError("", key, what + " cannot run on several MPI ranks yet: run it with --np 1");
+  };
+  if (!model_.picture_frames.empty()) refuse("picture_frame", "a picture-frame rig");
+  {  // a rank must integrate something: at most one rank per kernel chunk of the largest group
+    std::size_t most = 0, n_el = 0;
+    for (const auto& g : groups_) most = std::max(most, (g->size() + g->chunk() - 1) / g->chunk());
+    for (const auto& g : groups_) n_el += g->size();
+    const int p = PetscSession::size();
+    if (static_cast<std::size_t>(p) > most)
+      throw InputError("", "--np",
+                       std::to_string(p) + " MPI ranks for " + std::to_string(n_el) +
+                           " elements: the model splits into at most " + std::to_string(most) +
+                           " (one kernel chunk of 32 hexahedra or 256 bars per rank at least)");
+  }
+  domain_ = std::make_unique<Domain>(PETSC_COMM_WORLD, model_.mesh.n_nodes(), groups_);
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    const auto [b, e] = domain_->range(g);
+    if (!groups_[g]->set_range(b, e))
+      refuse("part." + model_.mesh.part_names[static_cast<std::size_t>(groups_[g]->part())],
+             std::string("a part of ") + element_noun(groups_[g]->kind()) + " elements");
+  }
+  // Each node meets each tool on the rank that owns it.
+  for (auto& tool : model_.tools)
+    std::erase_if(tool.contact_nodes,
+                  [&](std::int32_t i) { return !domain_->owns(static_cast<std::size_t>(i)); });
+}
+
+void ExplicitSolver::gather_for_output() {
+  if (!domain_) return;
+  for (NodalVector* vec : {&x, &v, &f_int, &f_ext, &f_contact, &f_damp, &reaction}) {
+    auto a = vec->view();
+    domain_->gather_to_root(a.data());
+  }
+  for (std::size_t g = 0; g < groups_.size(); ++g)
+    for (const auto& [data, comps] : groups_[g]->state_arrays())
+      domain_->gather_group_array(g, data, groups_[g]->size(), comps);
+  for (auto& tool : model_.tools) {
+    std::int64_t active = tool.n_active;
+    double pen = tool.max_penetration;
+    MPI_Reduce(domain_->root() ? MPI_IN_PLACE : &active, &active, 1, MPI_INT64_T, MPI_SUM, 0,
+               domain_->comm());
+    MPI_Reduce(domain_->root() ? MPI_IN_PLACE : &pen, &pen, 1, MPI_DOUBLE, MPI_MAX, 0,
+               domain_->comm());
+    if (domain_->root()) tool.n_active = active, tool.max_penetration = pen;
+  }
+  {  // what each rank holds and where its time went (load balance)
+    std::size_t n_el = 0;
+    for (std::size_t g = 0; g < groups_.size(); ++g)
+      n_el += domain_->range(g).second - domain_->range(g).first;
+    const double mine[] = {static_cast<double>(n_el),
+                           static_cast<double>(domain_->n_owned()),
+                           static_cast<double>(domain_->n_ghosts()),
+                           static_cast<double>(domain_->ghost_bytes_per_cycle()),
+                           timers_.internal_force,
+                           timers_.contact,
+                           timers_.update,
+                           timers_.exchange};
+    constexpr int kN = static_cast<int>(std::size(mine));
+    std::vector<double> all(domain_->root() ? kN * static_cast<std::size_t>(domain_->size()) : 0);
+    MPI_Gather(mine, kN, MPI_DOUBLE, all.data(), kN, MPI_DOUBLE, 0, domain_->comm());
+    rank_reports_.clear();
+    for (std::size_t r = 0; domain_->root() && r < static_cast<std::size_t>(domain_->size()); ++r) {
+      const double* a = &all[kN * r];
+      rank_reports_.push_back({static_cast<std::size_t>(a[0]), static_cast<std::size_t>(a[1]),
+                               static_cast<std::size_t>(a[2]), static_cast<std::size_t>(a[3]),
+                               PhaseTimers{a[4], a[5], a[6], 0.0, a[7]}});
+    }
+  }
+  contact_resultants_.resize(model_.contacts.size());
+  contact_max_penetration_.resize(model_.contacts.size());
+  for (std::size_t k = 0; k < model_.contacts.size(); ++k) {
+    auto res = model_.contacts[k]->resultants();
+    std::vector<double> buf;
+    for (const auto& r : res) buf.insert(buf.end(), {r.force.x, r.force.y, r.force.z});
+    double pen = model_.contacts[k]->max_penetration();
+    MPI_Reduce(domain_->root() ? MPI_IN_PLACE : buf.data(), buf.data(), static_cast<int>(buf.size()),
+               MPI_DOUBLE, MPI_SUM, 0, domain_->comm());
+    MPI_Reduce(domain_->root() ? MPI_IN_PLACE : &pen, &pen, 1, MPI_DOUBLE, MPI_MAX, 0,
+               domain_->comm());
+    for (std::size_t j = 0; j < res.size(); ++j) res[j].force = V3::at(&buf[3 * j]);
+    contact_resultants_[k] = std::move(res);
+    contact_max_penetration_[k] = pen;
+  }
+}
+
+std::vector<ContactResultant> ExplicitSolver::contact_resultants(std::size_t k) const {
+  return domain_ ? contact_resultants_.at(k) : model_.contacts.at(k)->resultants();
+}
+
+double ExplicitSolver::contact_max_penetration(std::size_t k) const {
+  return domain_ ? contact_max_penetration_.at(k) : model_.contacts.at(k)->max_penetration();
 }
 
 std::size_t ExplicitSolver::n_elements(ElementKind kind) const {
@@ -260,7 +428,7 @@ void ExplicitSolver::build_motions() {
           fixed_mask_[3 * static_cast<std::size_t>(node) + static_cast<std::size_t>(c)] = 254;
       }
   for (std::size_t d = 0; d < 3 * n; ++d)
-    if (fixed_mask_[d]) constrained_.push_back(d);
+    if (fixed_mask_[d] && (!domain_ || domain_->owns(d / 3))) constrained_.push_back(d);
   constrained_vo_.resize(constrained_.size());
   motion_v_.assign(constrained_.size(), 0.0);
   auto X0 = x0.view();
@@ -318,7 +486,9 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bo
     const int nn = g.nodes_per_element();
     const std::size_t offset = model_.mesh.element_offset(g.kind());
     StableStep left;
-    for (std::size_t e = 0; e < g.size(); ++e) {
+    const auto [e_begin, e_end] =
+        domain_ ? domain_->range(k) : std::pair<std::size_t, std::size_t>{0, g.size()};
+    for (std::size_t e = e_begin; e < e_end; ++e) {
       const double dt = step_scratch_[e];
       const bool folded = check_steps && dt_erode > 0 && !(jacobian_scratch_[e] > 0);
       const bool too_small = check_steps && dt_erode > 0 && sf * dt < dt_erode;
@@ -348,12 +518,71 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bo
       energy_.eroded_internal += g.erode(e);
       gone.push_back(static_cast<std::int32_t>(offset + static_cast<std::size_t>(g.set_index(e))));
       erosions_.push_back(ev);
+      if (domain_) local_erosions_.push_back({k, e});
     }
     group_step_[k] = left;
   }
+  if (domain_) share_erosions(gone, orphans);
   if (!gone.empty())
     for (auto& c : model_.contacts) c->erode(gone);
   if (!orphans.empty()) free_orphan_nodes(orphans);
+}
+
+// Several ranks: every rank learns the elements the others eroded this cycle (in the order one
+// rank would have eroded them: group, then element), takes them out of its copies of the groups,
+// contacts and node counts, and lists the events; each rank has booked the energies of its own.
+void ExplicitSolver::share_erosions(std::vector<std::int32_t>& gone,
+                                    std::vector<std::int32_t>& orphans) {
+  constexpr int kFields = 12;
+  const std::size_t n_mine = local_erosions_.size();
+  std::vector<double> mine;
+  for (std::size_t q = 0; q < n_mine; ++q) {
+    const ErosionEvent& ev = erosions_[erosions_.size() - n_mine + q];
+    mine.insert(mine.end(), {static_cast<double>(local_erosions_[q].first),
+                             static_cast<double>(local_erosions_[q].second),
+                             static_cast<double>(ev.cause), ev.time, static_cast<double>(ev.cycle),
+                             static_cast<double>(ev.element), static_cast<double>(ev.kind),
+                             static_cast<double>(ev.part), ev.step, ev.centroid.x, ev.centroid.y,
+                             ev.centroid.z});
+  }
+  local_erosions_.clear();
+  const int p = domain_->size();
+  std::vector<int> counts(static_cast<std::size_t>(p)), displs(static_cast<std::size_t>(p));
+  int n = static_cast<int>(mine.size());
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, domain_->comm());
+  int total = 0;
+  for (int r = 0; r < p; ++r) displs[static_cast<std::size_t>(r)] = total, total += counts[static_cast<std::size_t>(r)];
+  eroded_any_ = total > 0;
+  if (total == 0) return;
+  std::vector<double> all(static_cast<std::size_t>(total));
+  MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
+                 domain_->comm());
+  std::vector<std::size_t> order(static_cast<std::size_t>(total / kFields));
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return std::pair{all[kFields * a], all[kFields * a + 1]} <
+           std::pair{all[kFields * b], all[kFields * b + 1]};
+  });
+  erosions_.resize(erosions_.size() - n_mine);
+  gone.clear();
+  for (std::size_t q : order) {
+    const double* f = &all[kFields * q];
+    const auto k = static_cast<std::size_t>(f[0]), e = static_cast<std::size_t>(f[1]);
+    ElementGroup& g = *groups_[k];
+    erosions_.push_back({static_cast<ErosionEvent::Cause>(static_cast<int>(f[2])), f[3],
+                         static_cast<std::int64_t>(f[4]), static_cast<std::int64_t>(f[5]),
+                         static_cast<ElementKind>(static_cast<int>(f[6])), static_cast<int>(f[7]),
+                         f[8], V3{f[9], f[10], f[11]}});
+    gone.push_back(static_cast<std::int32_t>(model_.mesh.element_offset(g.kind()) +
+                                             static_cast<std::size_t>(g.set_index(e))));
+    const auto [b, end] = domain_->range(k);
+    if (e >= b && e < end) continue;  // mine: done in erode()
+    g.erode(e);  // its energy was booked by the rank that integrates it
+    for (int I = 0; I < g.nodes_per_element(); ++I) {
+      const std::int32_t node = g.conn()[static_cast<std::size_t>(I) * g.size() + e];
+      if (--node_elements_[static_cast<std::size_t>(node)] == 0) orphans.push_back(node);
+    }
+  }
 }
 
 // A node no element holds would drift on with its last velocity, hit the tools and feed them
@@ -368,7 +597,8 @@ void ExplicitSolver::free_orphan_nodes(const std::vector<std::int32_t>& candidat
     const auto i = static_cast<std::size_t>(node);
     if (node_elements_[i] != 0 || node_freed_[i]) continue;
     if (fixed_mask_[3 * i] || fixed_mask_[3 * i + 1] || fixed_mask_[3 * i + 2]) continue;
-    for (std::size_t d = 3 * i; d < 3 * i + 3; ++d) freeing_.push_back(d);
+    if (!domain_ || domain_->owns(i))  // its owner holds it (and books its kinetic energy)
+      for (std::size_t d = 3 * i; d < 3 * i + 3; ++d) freeing_.push_back(d);
     node_freed_[i] = 1;
     ++n_freed_nodes_;
     any = true;
@@ -452,6 +682,11 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     if (has_ext) std::fill(Fe.data(), Fe.data() + nd, 0.0);
     if (has_contact) std::fill(Fc.data(), Fc.data() + nd, 0.0);
 
+    // Several ranks: energies booked directly in the cycle (erosion) are summed over the ranks
+    // as increments from here.
+    const std::array<double, 3> booked0 = {energy_.internal, energy_.eroded_internal,
+                                           energy_.eroded_kinetic};
+    eroded_any_ = false;
     // Internal forces at x^n from v^{n-1/2}.
     ElementEnergyIncrement inc;
     StableStep st;
@@ -479,10 +714,12 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       erode(X.data(), Vv.data(), dt_erode, check_steps);
     }
     for (const auto& s : group_step_) take_smaller(st, s);
-    energy_.internal += inc.internal;
-    energy_.stabilisation += inc.stabilisation;
-    energy_.hourglass += inc.hourglass;
-    energy_.rotational_kinetic += inc.kinetic;
+    if (!domain_) {  // on several ranks they are summed over the ranks with the works below
+      energy_.internal += inc.internal;
+      energy_.stabilisation += inc.stabilisation;
+      energy_.hourglass += inc.hourglass;
+      energy_.rotational_kinetic += inc.kinetic;
+    }
     step_ = st;
     dt_new = model_.time.safety_factor * st.dt;
     if (dt_prev_ > 0) dt_new = std::min(dt_new, 1.1 * dt_prev_);  // limit step growth
@@ -501,6 +738,17 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     for (auto& m : motions_)
       if (m->has_forces()) m->add_forces(t_, X.data(), M.data(), dt_c, Fc.data());
     timers_.contact += seconds_since(t0);
+    if (domain_) {
+      // The smallest step of all ranks (its element named as on one rank) and every node's
+      // whole force on its owner.
+      t0 = Clock::now();
+      reduce_step(domain_->comm(), dt_new, st);
+      step_ = st;
+      domain_->add_ghosts_to_owners(fi);
+      if (has_contact) domain_->add_ghosts_to_owners(Fc.data());
+      timers_.exchange += seconds_since(t0);
+      t0 = Clock::now();
+    }
 
     // External forces at t^n, damping from v^{n-1/2}.
     t0 = Clock::now();
@@ -559,7 +807,10 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     const std::size_t kind =
         (xfused ? 8 : 0) + (has_ext ? 4 : 0) + (has_contact ? 2 : 0) + (alpha != 0 ? 1 : 0);
     auto [ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke] =
-        kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused);
+        domain_ ? owned_node_update(kNodeUpdates[kind], domain_->owned_runs(), alpha, dt_mid,
+                                    dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused)
+                : kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel,
+                                     fdamp, xfused);
     // Works over the increments du_old = dt_prev v^{n-1/2}, du_new = dt_new v^{n+1/2}; kinetic
     // energy in product form: with the trapezoidal works, 1/2 v^{n-1/2} M v^{n+1/2} makes the
     // discrete energy balance of central differences exact for conservative forces.
@@ -605,13 +856,38 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       inv_mass_[d] = 0;
     }
     freeing_.clear();
-    w_ext_.add(ext_old, ext_new);
+    // An eroded element's nodes may be owned elsewhere: their v^{n+1/2} first.
+    if (domain_ && eroded_any_) domain_->refresh_ghosts(vel);
     for (const auto& ef : eroded_forces_)  // see ErodedForce
       for (int I = 0; I < ef.n_nodes; ++I)
         for (int c = 0; c < 3; ++c)
           energy_.internal +=
               0.5 * ef.f[3 * I + c] * dt_new * vel[3 * static_cast<std::size_t>(ef.node[I]) + c];
     eroded_forces_.clear();
+    if (domain_) {
+      // Works, kinetic energy, element energy increments, tool forces and friction: each rank
+      // holds its nodes' and elements' share.
+      const auto tr = Clock::now();
+      std::vector<double>& r = reduce_buffer_;
+      r.assign({ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke, inc.internal,
+                inc.stabilisation, inc.hourglass, inc.kinetic, energy_.internal - booked0[0],
+                energy_.eroded_internal - booked0[1], energy_.eroded_kinetic - booked0[2]});
+      for (const auto& tool : model_.tools) r.insert(r.end(), {tool.force.x, tool.force.y, tool.force.z});
+      MPI_Allreduce(MPI_IN_PLACE, r.data(), static_cast<int>(r.size()), MPI_DOUBLE, MPI_SUM,
+                    domain_->comm());
+      ext_old = r[0], ext_new = r[1], damp_old = r[2], damp_new = r[3], con_old = r[4],
+      con_new = r[5], ke = r[6];
+      energy_.internal = booked0[0] + r[11] + r[7];
+      energy_.eroded_internal = booked0[1] + r[12];
+      energy_.eroded_kinetic = booked0[2] + r[13];
+      energy_.stabilisation += r[8];
+      energy_.hourglass += r[9];
+      energy_.rotational_kinetic += r[10];
+      for (std::size_t k = 0; k < model_.tools.size(); ++k)
+        model_.tools[k].force = {r[14 + 3 * k], r[15 + 3 * k], r[16 + 3 * k]};
+      timers_.exchange += seconds_since(tr);
+    }
+    w_ext_.add(ext_old, ext_new);
     w_damp_.add(damp_old, damp_new);
     w_contact_nodes_.add(con_old, con_new);
 
@@ -658,6 +934,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     double fr = 0;
     for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
     for (const auto& c : model_.contacts) fr += c->friction_dissipation();
+    if (domain_) MPI_Allreduce(MPI_IN_PLACE, &fr, 1, MPI_DOUBLE, MPI_SUM, domain_->comm());
     energy_.friction = fr;
     energy_.scale_max = std::max(energy_.scale_max, energy_.scale());
     if (!std::isfinite(ke)) check_finite(Vv.data());
@@ -674,7 +951,20 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
   if (at_tn) {
     auto X = x.view();
     auto Vv = v.view();
-    for (std::size_t d = 0; d < nd; ++d) X[d] += dt_new * Vv[d];
+    if (domain_) {
+      for (const auto& [b, e] : domain_->owned_runs())
+        for (std::size_t d = 3 * b; d < 3 * e; ++d) X[d] += dt_new * Vv[d];
+    } else {
+      for (std::size_t d = 0; d < nd; ++d) X[d] += dt_new * Vv[d];
+    }
+  }
+  if (domain_) {
+    t0 = Clock::now();
+    auto X = x.view();
+    auto Vv = v.view();
+    domain_->refresh_ghosts(X.data());
+    domain_->refresh_ghosts(Vv.data());
+    timers_.exchange += seconds_since(t0);
   }
   for (auto& tool : model_.tools) tool.displacement += dt_new * tool.velocity;
   t_ += dt_new;

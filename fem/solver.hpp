@@ -23,6 +23,7 @@ struct PartMassReport {
 };
 
 class PictureFrameMotion;
+class Domain;
 class CheckpointWriter;
 class CheckpointReader;
 
@@ -63,12 +64,23 @@ struct ErosionEvent {
 
 struct PhaseTimers {
   double internal_force = 0, contact = 0, update = 0, output = 0;  // seconds
+  double exchange = 0;  // MPI: ghost exchange and reductions (0 on one rank)
+};
+
+/// One MPI rank's share of a run (ExplicitSolver::rank_reports).
+struct RankReport {
+  std::size_t elements = 0;      // elements it integrates
+  std::size_t owned_nodes = 0;   // nodes it updates
+  std::size_t ghost_nodes = 0;   // nodes it reads from other ranks
+  std::size_t ghost_bytes = 0;   // bytes it sends per cycle in the ghost exchange
+  PhaseTimers timers;            // its phase times so far (output excluded)
 };
 
 class ExplicitSolver {
  public:
   /// Builds element groups, masses and the initial state. Throws InputError / NumericalError.
   explicit ExplicitSolver(Model& model);
+  ~ExplicitSolver();
 
   /// One cycle. `at_tn` (may be empty) is called once state at t^n is complete (forces,
   /// energies, v^{n+1/2}), before the positions move on to t^{n+1}.
@@ -89,6 +101,18 @@ class ExplicitSolver {
   /// contact, their kinetic energy booked as EnergyBalance::eroded_kinetic.
   std::size_t n_freed_nodes() const { return n_freed_nodes_; }
   const PhaseTimers& timers() const { return timers_; }
+  /// The split over MPI ranks (fem/parallel/domain.hpp); null on one rank.
+  const Domain* domain() const { return domain_.get(); }
+  /// On several ranks: brings the whole state to the root (nodal arrays, element state, tool
+  /// counters) so that output code reads it there as on one rank. Collective; nothing on one rank.
+  void gather_for_output();
+  /// Resultants and deepest penetration of contact k (ContactAlgorithm's); on several ranks the
+  /// sums (maximum) over the ranks as of the last gather_for_output.
+  std::vector<ContactResultant> contact_resultants(std::size_t k) const;
+  double contact_max_penetration(std::size_t k) const;
+  /// On the root of several ranks: each rank's share as of the last gather_for_output (empty
+  /// on one rank).
+  const std::vector<RankReport>& rank_reports() const { return rank_reports_; }
   std::size_t n_elements(ElementKind kind) const;
   std::size_t n_elements() const;
 
@@ -144,13 +168,20 @@ class ExplicitSolver {
   /// Without `check_steps` only the elements the material has failed are eroded.
   /// Nodes of eroded elements left with no element are taken out (see n_freed_nodes).
   void erode(const double* x, const double* v, double dt_erode, bool check_steps);
+  /// Several ranks: shares this cycle's erosions (see solver.cpp); `gone` becomes every rank's.
+  void share_erosions(std::vector<std::int32_t>& gone, std::vector<std::int32_t>& orphans);
   /// Takes out the nodes of `candidates` that no element holds any more and no constraint drives.
   void free_orphan_nodes(const std::vector<std::int32_t>& candidates);
   /// "(x, y, z) m": centroid at x of the element a StableStep names (for messages).
   std::string element_position(const StableStep& st, const double* x) const;
 
+  /// Splits the model over the ranks of PETSC_COMM_WORLD (more than one): InputError for what
+  /// cannot be split yet.
+  void decompose();
+
   Model& model_;
   std::vector<std::unique_ptr<ElementGroup>> groups_;
+  std::unique_ptr<Domain> domain_;
   std::vector<StableStep> group_step_;                    // per group, this cycle
   std::vector<std::unique_ptr<BoundaryMotion>> motions_;  // rigs that drive nodes (picture frames)
   PictureFrameMotion* frames_ = nullptr;                  // among motions_
@@ -163,6 +194,12 @@ class ExplicitSolver {
   std::vector<double> freeing_vo_;    // their v^{n-1/2}
   bool material_failure_ = false;     // a group's material can fail elements
   std::vector<double> step_scratch_, jacobian_scratch_;
+  std::vector<double> reduce_buffer_;  // per-cycle sums over the ranks
+  std::vector<std::pair<std::size_t, std::size_t>> local_erosions_;  // (group, element) this cycle
+  bool eroded_any_ = false;  // several ranks: some rank eroded an element this cycle
+  std::vector<std::vector<ContactResultant>> contact_resultants_;  // several ranks: summed
+  std::vector<double> contact_max_penetration_;
+  std::vector<RankReport> rank_reports_;
   /// Elements eroded this cycle: their nodes and nodal internal forces at t^n. Their work over the
   /// first half of the next increment, which the trapezoidal external work counts, is booked
   /// as internal energy once the increment is known (the element no longer does it).

@@ -5,11 +5,16 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <unistd.h>
+#include <vector>
 
 #include "fem/errors.hpp"
 #include "fem/petsc_vector.hpp"
@@ -31,6 +36,43 @@
 namespace wf = ncfsim::workflow;
 
 namespace {
+
+// Whether this process was started by an MPI launcher (Open MPI, MPICH/Hydra, Slurm's PMI).
+bool under_mpi_launcher() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS"})
+    if (std::getenv(v)) return true;
+  return false;
+}
+
+// `ncfsim run ... --np N` outside a launcher: starts N ranks of this same executable with the
+// launcher CMake found, the same arguments less --np (docs/cli.md). Open MPI refuses to run as
+// root and more ranks than cores unless told: both allowed here, as the user asked for N.
+int relaunch_with_mpiexec(int ranks, int argc, char** argv) {
+  std::vector<std::string> args = {NCFSIM_MPIEXEC, "-n", std::to_string(ranks)};
+  char exe[4096];
+  const ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  args.emplace_back(len > 0 ? std::string(exe, static_cast<std::size_t>(len)) : argv[0]);
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--np") {
+      ++i;
+      continue;
+    }
+    if (a.rfind("--np=", 0) == 0) continue;
+    args.push_back(a);
+  }
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+  ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
+  std::vector<char*> cargs;
+  for (auto& a : args) cargs.push_back(a.data());
+  cargs.push_back(nullptr);
+  std::fflush(nullptr);
+  execvp(cargs[0], cargs.data());
+  std::fprintf(stderr, "ncfsim: bad input: --np %d: cannot start the MPI launcher '%s': %s\n", ranks,
+               args[0].c_str(), std::strerror(errno));
+  return wf::kBadInput;
+}
 
 int bad_input(const std::exception& e) {
   std::fprintf(stderr, "ncfsim: bad input: %s\n", e.what());
@@ -275,6 +317,7 @@ int main(int argc, char** argv) {
       return wf::check_stage(call);
     }
     if (*run) {  // [case] kind -> its stage (workflow/stages/stage_registry.hpp)
+      if (ranks > 1 && !under_mpi_launcher()) return relaunch_with_mpiexec(ranks, argc, argv);
       wf::StageCall call;
       call.case_file = case_file;
       call.overrides = overrides;

@@ -93,6 +93,8 @@ void read_loads(CaseReadContext& ctx) {
     model.mass_damping = d->number("mass_proportional", 0.0, Range::non_negative());
     model.mass_damping_end_time = d->number("end_time", 0.0, Range::non_negative());
   }
+  if (auto par = ctx.root.table("parallel"))
+    model.parallel.contact_halo = par->number("contact_halo", 0.01, Range::positive());
   if (auto init = ctx.root.table("initial"))
     for (const auto& t : init->tables("velocity"))
       model.initial_velocities.push_back(

@@ -1,10 +1,12 @@
 #include "fem/contact/penalty_contact.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <unordered_set>
 
 #include "fem/checkpoint.hpp"
 #include "fem/contact/contact_force_kernel.hpp"
@@ -222,13 +224,73 @@ bool PenaltyContact::closer_adjacent_face(const double* x, const std::int32_t* a
   return false;
 }
 
+bool PenaltyContact::nodes_to_read(const std::uint8_t* owned, const double* x0, double halo,
+                                   std::vector<std::int32_t>& out) const {
+  // Cells of size `halo` holding an owned surface node, and their neighbours: a segment with a
+  // corner in one of them is within 2 sqrt(3) halo of an owned node (at least `halo`).
+  const auto key = [&](const double* p) {
+    std::array<std::int64_t, 3> c;
+    for (int k = 0; k < 3; ++k) c[k] = static_cast<std::int64_t>(std::floor(p[k] / halo));
+    return c;
+  };
+  const auto pack = [](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
+  };
+  std::unordered_set<std::int64_t> near;
+  for (std::size_t e = 0; e < surf_.n_nodes(); ++e) {
+    const auto i = static_cast<std::size_t>(surf_.node[e]);
+    if (!owned[i]) continue;
+    const auto c = key(x0 + 3 * i);
+    for (std::int64_t a = -1; a <= 1; ++a)
+      for (std::int64_t b = -1; b <= 1; ++b)
+        for (std::int64_t d = -1; d <= 1; ++d) near.insert(pack(c[0] + a, c[1] + b, c[2] + d));
+  }
+  for (std::size_t s = 0; s < surf_.n_segments(); ++s) {
+    bool in = false;
+    for (int k = 0; k < 4 && !in; ++k) {
+      const auto c = key(x0 + 3 * static_cast<std::size_t>(surf_.seg_nodes[4 * s + k]));
+      in = near.count(pack(c[0], c[1], c[2])) > 0;
+    }
+    if (in)  // the whole hexahedron: the closest-feature test reads its other faces
+      out.insert(out.end(), &surf_.seg_elem_nodes[8 * s], &surf_.seg_elem_nodes[8 * s] + 8);
+  }
+  return true;
+}
+
+void PenaltyContact::restrict_to_rank(const std::uint8_t* owned, const std::uint8_t* readable) {
+  node_mine_.assign(surf_.n_nodes(), 0);
+  for (std::size_t e = 0; e < surf_.n_nodes(); ++e)
+    node_mine_[e] = owned[static_cast<std::size_t>(surf_.node[e])];
+  node_readable_.clear();
+  for (std::size_t e = 0; e < surf_.n_nodes(); ++e)
+    if (readable[static_cast<std::size_t>(surf_.node[e])])
+      node_readable_.push_back(static_cast<std::int32_t>(e));
+  seg_remote_.assign(surf_.n_segments(), 0);
+  frame_blocks_.clear();
+  for (std::size_t s = 0; s < surf_.n_segments(); ++s) {
+    for (int k = 0; k < 8; ++k)
+      if (!readable[static_cast<std::size_t>(surf_.seg_elem_nodes[8 * s + k])]) seg_remote_[s] = 1;
+    const std::size_t blk = s / kFrameLanes;
+    if (!seg_remote_[s] && (frame_blocks_.empty() || frame_blocks_.back() != blk))
+      frame_blocks_.push_back(blk);
+  }
+  collect_active_segments();
+  box_lo_.resize(3 * active_seg_.size());
+  box_hi_.resize(3 * active_seg_.size());
+  resort_ = true;
+}
+
 void PenaltyContact::sort_segments(const double* x) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t ng = n_groups_, n_node = surf_.n_nodes(), n_act = active_seg_.size();
   const double margin = margin_;
   resort_ = false;
   // Frames of all segments, grown boxes of the active ones.
-  for (std::size_t blk = 0; blk < frame_.size() / kFrameLanes; ++blk) compute_frames(x, blk);
+  if (frame_blocks_.empty()) {
+    for (std::size_t blk = 0; blk < frame_.size() / kFrameLanes; ++blk) compute_frames(x, blk);
+  } else {  // several ranks: the blocks holding a segment this rank reads
+    for (auto blk : frame_blocks_) compute_frames(x, blk);
+  }
   for (std::size_t a = 0; a < n_act; ++a) {
     const auto s = static_cast<std::size_t>(active_seg_[a]);
     double p[4][3];
@@ -252,7 +314,8 @@ void PenaltyContact::sort_segments(const double* x) {
     double sum[kMaxFacets][3] = {};
     double unit[kMaxFacets][3] = {};
     int nf = 0;
-    for (std::int32_t r = node_seg_start_[e]; r < node_seg_start_[e + 1]; ++r) {
+    const bool mine = node_mine_.empty() || node_mine_[e];  // another rank's node: no facets
+    for (std::int32_t r = node_seg_start_[e]; mine && r < node_seg_start_[e + 1]; ++r) {
       const auto q = static_cast<std::size_t>(node_seg_[static_cast<std::size_t>(r)]);
       if (seg_off(q)) continue;  // a node left without segments (or inside) faces nothing
       const double* n = frame_[q].n;
@@ -302,6 +365,7 @@ void PenaltyContact::sort_segments(const double* x) {
     const auto i = static_cast<std::size_t>(surf_.node[e]);
     const double* p = x + 3 * i;
     for (int k = 0; k < 3; ++k) x_sorted_[3 * e + k] = p[k];
+    if (!node_mine_.empty() && !node_mine_[e]) continue;  // another rank's node
     const int nf = n_facets_[e];
     const double* fn = &facet_[3 * kMaxFacets * e];
     const std::size_t row = static_cast<std::size_t>(surf_.node_group[e]) * ng;
@@ -382,10 +446,15 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     double d2 = 0;
     const std::int32_t* node = surf_.node.data();
     const double* xs = x_sorted_.data();
-    for (std::size_t e = 0; e < n_node; ++e) {
+    const auto moved = [&](std::size_t e) {
       const double* p = x + 3 * static_cast<std::size_t>(node[e]);
       const double dx = p[0] - xs[3 * e], dy = p[1] - xs[3 * e + 1], dz = p[2] - xs[3 * e + 2];
       d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
+    };
+    if (node_readable_.empty()) {
+      for (std::size_t e = 0; e < n_node; ++e) moved(e);
+    } else {  // several ranks: the nodes this rank reads (the others do not move here)
+      for (auto e : node_readable_) moved(static_cast<std::size_t>(e));
     }
     const double reach = 0.5 * (margin_ - cfg_.thickness);
     stats_.check_seconds += seconds(t0, Clock::now());

@@ -86,6 +86,11 @@ class PenaltyContact final : public ContactAlgorithm {
   /// Saves the facets' friction state, the positions of the last sort and the segment flags;
   /// load_state sorts again at the saved positions (the sort reads nothing else), which rebuilds
   /// the candidates, frames and grid exactly, then overwrites the friction state.
+  /// Several ranks: the segments (with their hexahedra) near this rank's surface nodes.
+  bool nodes_to_read(const std::uint8_t* owned, const double* x0, double halo,
+                     std::vector<std::int32_t>& out) const override;
+  /// Several ranks: candidates only for owned surface nodes, among readable segments.
+  void restrict_to_rank(const std::uint8_t* owned, const std::uint8_t* readable) override;
   void save_state(CheckpointWriter& w) const override;
   void load_state(CheckpointReader& r) override;
 
@@ -179,7 +184,14 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<std::uint8_t> seg_in_pair_;  // [n_seg] 1: its group is in a pair
   /// Rebuilds active_seg_: segments of paired groups neither eroded nor dormant.
   void collect_active_segments();
-  bool seg_off(std::size_t s) const { return seg_eroded_[s] || seg_dormant_[s]; }
+  bool seg_off(std::size_t s) const {
+    return seg_eroded_[s] || seg_dormant_[s] || (!seg_remote_.empty() && seg_remote_[s]);
+  }
+  // Several ranks: [n_seg] 1: a segment this rank cannot read (beyond its halo); [n_snode] 1: a
+  // surface node this rank owns (empty on one rank: every node).
+  std::vector<std::uint8_t> seg_remote_, node_mine_;
+  std::vector<std::int32_t> node_readable_;  // surface nodes this rank reads
+  std::vector<std::size_t> frame_blocks_;    // frame blocks holding a segment it reads
   bool resort_ = false;  // the surface changed: sort before the next cycle
   BucketGrid grid_;
 

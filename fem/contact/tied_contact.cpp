@@ -301,12 +301,25 @@ double TiedContact::failed_area() const {
   return a;
 }
 
+bool TiedContact::nodes_to_read(const std::uint8_t* owned, const double*, double,
+                                std::vector<std::int32_t>& out) const {
+  for (std::size_t t = 0; t < node_.size(); ++t)
+    if (owned[static_cast<std::size_t>(node_[t])])
+      out.insert(out.end(), &corner_[4 * t], &corner_[4 * t] + 4);
+  return true;
+}
+
+void TiedContact::restrict_to_rank(const std::uint8_t* owned, const std::uint8_t*) {
+  mine_.assign(node_.size(), 0);
+  for (std::size_t t = 0; t < node_.size(); ++t) mine_[t] = owned[static_cast<std::size_t>(node_[t])];
+}
+
 void TiedContact::add_forces(const double* x, const double*, const double*, double, double* f) {
   const std::size_t n = node_.size();
   double Rx = 0, Ry = 0, Rz = 0, released = 0, alive_dissipation = 0;
   std::int64_t failed = 0;
   for (std::size_t t = 0; t < n; ++t) {
-    if (!alive_[t]) continue;
+    if (!alive_[t] || (!mine_.empty() && !mine_[t])) continue;
     double q[4][3];
     gather_segment(x, &corner_[4 * t], q);
     TieFrame tf;

@@ -32,6 +32,10 @@ class TiedContact final : public ContactAlgorithm {
   std::int64_t active_contacts() const override { return n_alive_; }
   /// Ties on faces of eroded hexahedra fail in the next add_forces (their energy released).
   void erode(const std::vector<std::int32_t>& mesh_elements) override;
+  /// Several ranks: the master segments of the ties of owned slave nodes.
+  bool nodes_to_read(const std::uint8_t* owned, const double* x0, double halo,
+                     std::vector<std::int32_t>& out) const override;
+  void restrict_to_rank(const std::uint8_t* owned, const std::uint8_t* readable) override;
   void save_state(CheckpointWriter& w) const override;
   void load_state(CheckpointReader& r) override;
 
@@ -77,6 +81,7 @@ class TiedContact final : public ContactAlgorithm {
   // and force of the last cycle; what a tie dissipated is its work less the energy it holds.
   std::vector<double> tie_work_, last_sep_, last_force_;
   double failed_work_ = 0;           // work done on the ties that have failed (all dissipated)
+  std::vector<std::uint8_t> mine_;  // several ranks: [n_tie] 1: its slave node is owned here
   std::vector<std::uint8_t> alive_;  // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
   std::int64_t n_alive_ = 0;
   double dissipation_ = 0;

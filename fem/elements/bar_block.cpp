@@ -123,8 +123,9 @@ void bar_internal_forces(BarBlock& b, const double* x, double* f, ElementEnergyI
   double* F_p = b.force.data();
   alignas(64) double sx[BC], sy[BC], sz[BC];  // axial force vector of each bar of the chunk
   VD w = 0.0;
-  for (std::size_t e0 = 0; e0 < n; e0 += BC) {
-    const int m = static_cast<int>(std::min<std::size_t>(BC, n - e0));
+  const std::size_t e_end = std::min(n, b.range_end);
+  for (std::size_t e0 = b.range_begin; e0 < e_end; e0 += BC) {
+    const int m = static_cast<int>(std::min<std::size_t>(BC, e_end - e0));
     for (int k = 0; k < m; k += W) {
       const int cnt = std::min(W, m - k);
       const std::size_t e = e0 + static_cast<std::size_t>(k);

@@ -53,6 +53,8 @@ struct BarBlock {
   std::vector<double> strain;         // [n] engineering strain at the last update
   std::vector<double> force;          // [n] axial force at the last update
   std::vector<double> dt_crit;        // [n] (fixed: depends on mass and slope only)
+  // Bars the per-cycle kernel integrates (a rank's run, fem/parallel/domain.hpp).
+  std::size_t range_begin = 0, range_end = static_cast<std::size_t>(-1);
   std::vector<double> mass_scale;     // [n] >1 where mass scaling raised the bar's step
 };
 

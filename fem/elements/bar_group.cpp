@@ -45,6 +45,14 @@ class BarGroup final : public ElementGroup {
                        StableStep& step) override {
     bar_internal_forces(block, s.x, f, energy, step);
   }
+  std::size_t chunk() const override { return 256; }
+  bool set_range(std::size_t begin, std::size_t end) override {
+    block.range_begin = begin, block.range_end = end;
+    return true;
+  }
+  std::vector<std::pair<double*, int>> state_arrays() override {
+    return {{block.strain.data(), 1}, {block.force.data(), 1}};
+  }
   std::vector<CellFieldSpec> cell_fields() const override {
     return {{"axial_force", 1}, {"axial_strain", 1}};
   }

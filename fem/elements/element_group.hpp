@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fem/elements/element_kind.hpp"
@@ -58,6 +59,19 @@ class ElementGroup {
   /// this group's controlling element.
   virtual void internal_forces(const ElementCycleState& s, double* f,
                                ElementEnergyIncrement& energy, StableStep& step) = 0;
+
+  // Domain decomposition (fem/parallel/domain.hpp).
+  /// Elements per kernel chunk: a rank's run of this group starts on a multiple of it.
+  virtual std::size_t chunk() const { return 1; }
+  /// Restricts the per-cycle kernels (forces, steps) to elements [begin, end) on this rank;
+  /// false for a kind that cannot be split over ranks.
+  virtual bool set_range(std::size_t begin, std::size_t end) {
+    (void)begin, (void)end;
+    return false;
+  }
+  /// The per-element state arrays, [components][size()] doubles each, that an output on the
+  /// root gathers from the ranks that integrate them.
+  virtual std::vector<std::pair<double*, int>> state_arrays() { return {}; }
 
   // Erosion (kinds that can lose elements; the defaults are for those that cannot).
   virtual bool can_erode() const { return false; }

@@ -18,7 +18,7 @@ namespace ncfsim::fem {
 namespace stdx = std::experimental;
 namespace {
 
-constexpr int CH = 32;  // elements per chunk: the chunk scratch (~20 KB) stays in L1
+constexpr int CH = static_cast<int>(kHex8Chunk);  // elements per chunk: the chunk scratch (~20 KB) stays in L1
 
 constexpr const auto& S = kHex8Sign;
 
@@ -534,7 +534,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
   // follow: every stream of the chunk kAhead chunks ahead is requested (into L2) while this one
   // computes.
   auto prefetch_chunk = [&](std::size_t c0) {
-    if (c0 >= n) return;
+    if (c0 >= std::min(n, b.range_end)) return;
     const std::size_t cn = std::min<std::size_t>(CH, n - c0);
     auto rows = [&]<int rw>(const auto* base, int n_rows, std::integral_constant<int, rw>) {
       constexpr std::size_t per_line = 64 / sizeof(*base);
@@ -557,10 +557,11 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
     rows(b.volume.data(), 1, write);
   };
   constexpr std::size_t kAhead = 4;  // chunks
-  for (std::size_t k = 0; k < kAhead; ++k) prefetch_chunk(k * CH);
+  const std::size_t e_begin = b.range_begin, e_end = std::min(n, b.range_end);
+  for (std::size_t k = 0; k < kAhead; ++k) prefetch_chunk(e_begin + k * CH);
 
-  for (std::size_t e0 = 0; e0 < n; e0 += CH) {
-    const int m = static_cast<int>(std::min<std::size_t>(CH, n - e0));
+  for (std::size_t e0 = e_begin; e0 < e_end; e0 += CH) {
+    const int m = static_cast<int>(std::min<std::size_t>(CH, e_end - e0));
     prefetch_chunk(e0 + kAhead * CH);
 
     // Pass A: kinematics, W elements at a time.

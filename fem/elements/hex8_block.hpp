@@ -24,6 +24,9 @@
 
 namespace ncfsim::fem {
 
+/// Elements per chunk of the hexahedron kernel.
+inline constexpr std::size_t kHex8Chunk = 32;
+
 struct Hex8Block {
   int part = 0;
   const SolidMaterial* material = nullptr;  // borrowed, outlives the block
@@ -50,6 +53,9 @@ struct Hex8Block {
   std::vector<std::int32_t> mesh_hex;  // [n] index into the mesh's hexahedron set
   std::vector<std::uint8_t> eroded;    // [n] 1: removed from the calculation (empty: none yet)
   std::size_t n_eroded = 0;
+  // Elements the per-cycle kernel integrates (a rank's run, fem/parallel/domain.hpp); a multiple
+  // of the kernel chunk (kHex8Chunk) to the end.
+  std::size_t range_begin = 0, range_end = static_cast<std::size_t>(-1);
   double hourglass_stiffness = 1.0;   // scale of the physical stabilisation (1 = exact bending)
   double hourglass_viscosity = 0.05;  // fraction of critical damping on the hourglass modes
   double p_modulus = 0.0;             // modulus of the stable-step bound (uniform-strain hex)

@@ -41,6 +41,19 @@ class Hex8Group final : public ElementGroup {
                        StableStep& step) override {
     hex8_internal_forces(block, s.x, s.v, s.dt, f, energy, step, s.x_ref);
   }
+  std::size_t chunk() const override { return kHex8Chunk; }
+  bool set_range(std::size_t begin, std::size_t end) override {
+    block.range_begin = begin, block.range_end = end;
+    return true;
+  }
+  std::vector<std::pair<double*, int>> state_arrays() override {
+    const int nh = block.material->n_history();
+    std::vector<std::pair<double*, int>> a = {{block.stress.data(), 6},    {block.strain.data(), 6},
+                                              {block.hg_force.data(), 12}, {block.hg_viscous.data(), 12},
+                                              {block.volume.data(), 1}};
+    if (nh > 0) a.emplace_back(block.history.data(), nh);
+    return a;
+  }
   bool can_erode() const override { return true; }
   void element_steps(const double* x, std::vector<double>& dt,
                      std::vector<double>* corner_jacobian) const override {

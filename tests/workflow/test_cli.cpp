@@ -233,37 +233,6 @@ TEST(Cli, ErosionIsReportedEverywhere) {
   fs::remove_all(out);
 }
 
-// Until the domain decomposition lands, a run started on several MPI ranks is refused (each rank
-// would run the whole model into the same files): exit code 2, the reason, no output folder.
-TEST(Cli, RefusesSeveralMpiRanks) {
-  const std::string mpiexec = NCFSIM_MPIEXEC;
-  if (mpiexec.empty() || !fs::exists(mpiexec)) GTEST_SKIP() << "no MPI launcher found by CMake";
-  // Open MPI refuses root and more ranks than cores unless told; MPICH ignores these.
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-  ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
-  const std::vector<std::string> two_ranks = {mpiexec, "-n", "2"};
-  const Result probe = run_cli({"--version"}, two_ranks);  // no PETSc: each rank just prints
-  if (probe.code != 0) GTEST_SKIP() << "the MPI launcher does not start here: " << probe.output;
-  const fs::path out = fresh_dir("two_ranks");
-  const fs::path log =
-      fs::temp_directory_path() / ("ncfsim_two_ranks_" + std::to_string(getpid()) + ".log");
-  // Without the guard the two ranks hang: give up after a minute rather than at CTest's timeout.
-  const int code = wait_code_within(
-      spawn({"run", (kSource / "cases/verification/cantilever.toml").string(), "-o", out.string()},
-            log, two_ranks),
-      60.0);
-  const std::string output = slurp(log);
-  fs::remove(log);
-  EXPECT_EQ(code, 2) << output;
-  EXPECT_NE(output.find("started on 2 MPI ranks, but the domain decomposition is not "
-                        "implemented yet"),
-            std::string::npos)
-      << output;
-  EXPECT_FALSE(fs::exists(out));
-  fs::remove_all(out);
-}
-
 // A run stopped by a non-finite state writes its energies as null in summary.json: its report
 // is still written, saying so.
 TEST(Cli, ReportOfARunThatBlewUp) {

@@ -18,6 +18,8 @@
 #include "fem/errors.hpp"
 #include "fem/io/hdf5_checkpoint.hpp"
 #include "fem/io/result_writers.hpp"
+#include "fem/parallel/domain.hpp"
+#include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
 #include "workflow/figures/figures.hpp"
 #include "workflow/report/report.hpp"
@@ -206,11 +208,9 @@ void log_start(const Run& r) {
               r.ec.resolution);
   if (!r.ec.description.empty()) r.log->info("  {}", r.ec.description);
   for (const auto& ov : r.options.overrides) r.log->info("  --set {}", ov);
-  if (r.options.ranks > 1)
-    r.log->warn(
-        "--np {}: this build runs the engine on one rank; the state is laid out for MPI "
-        "(ghosted PETSc vectors) but the domain decomposition is not implemented yet",
-        r.options.ranks);
+  if (fem::PetscSession::size() > 1)
+    r.log->info("on {} MPI ranks (domain decomposition, docs/parallel.md)",
+                fem::PetscSession::size());
 }
 
 std::unique_ptr<fem::ExplicitSolver> make_solver(EngineCase& ec, Run& r) {
@@ -247,6 +247,11 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
 void write_checkpoint(Run& r, const fem::ExplicitSolver& s, const MeasureList& measures,
                       const RunHistory& history, const FrameOutput& frames) {
   if (r.checkpoint_cycle == s.cycle()) return;
+  if (s.domain()) {  // docs/parallel.md: not yet on several ranks
+    if (r.checkpoint_cycle != -2) r.log->warn("no checkpoints on several MPI ranks (yet)");
+    r.checkpoint_cycle = -2;
+    return;
+  }
   const auto t0 = Clock::now();
   const std::filesystem::path file = r.dir / kCheckpointFile;
   try {
@@ -377,6 +382,20 @@ void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size
       for (const auto& line : m->after_erosion(s)) log.warn("{}", line);
 }
 
+// Ctrl-C on any rank stops every rank at the same cycle (a rank that stopped alone would leave
+// the others waiting in the next exchange).
+bool stop_requested(const fem::ExplicitSolver& s) {
+  int stop = StopRequest::requested() ? 1 : 0;
+  if (s.domain()) MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, s.domain()->comm());
+  return stop != 0;
+}
+
+// On several ranks the root gathers the whole state before a history row or a frame; the other
+// ranks take part (run_engine_worker) at the same cycles, which they find from the same times.
+bool output_due(double t, const Run::LoopState& loop) {
+  return t >= loop.next_history || t >= loop.next_frame;
+}
+
 void log_progress(const Run& r, const fem::ExplicitSolver& s, double err) {
   const auto& tc = s.model().time;
   const double t = s.time(), wall = r.wall_seconds(), frac = t / tc.end_time;
@@ -406,7 +425,7 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
         write_checkpoint(r, solver, measures, history, frames);
         break;
       }
-      if (StopRequest::requested()) {
+      if (stop_requested(solver)) {
         r.status = "interrupted";
         r.log->warn(
             "interrupted at t = {:.6g} s, cycle {}: writing a checkpoint, the last frame "
@@ -422,6 +441,7 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
         write_checkpoint(r, solver, measures, history, frames);
       solver.step([&] {
         const double t = solver.time();
+        if (output_due(t, r.loop)) solver.gather_for_output();
         log_erosions(solver, measures, erosions_logged, *r.log);
         const auto& balance = solver.energy();
         const double err = balance.error();
@@ -468,6 +488,7 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
       });
     }
     // Final state (positions at the end time; forces of the last cycle).
+    solver.gather_for_output();
     history.write_row(solver);
     frames.write(solver, measures, *r.log);
   } catch (const NumericalError& e) {
@@ -525,6 +546,37 @@ void draw_figures_and_report(const Run& r) {
 
 }  // namespace
 
+int run_engine_worker(EngineCase& ec, const RunOptions& options) {
+  if (options.resume) return kBadInput;  // the root says why
+  std::unique_ptr<fem::ExplicitSolver> solver_ptr;
+  try {
+    solver_ptr = std::make_unique<fem::ExplicitSolver>(ec.model);
+  } catch (const InputError&) {
+    return kBadInput;  // the root reports it
+  }
+  fem::ExplicitSolver& solver = *solver_ptr;
+  const auto& tc = solver.model().time;
+  Run::LoopState loop;
+  StopRequest::install();
+  try {
+    while (solver.time() < tc.end_time * (1 - 1e-12)) {
+      if (tc.max_cycles > 0 && solver.cycle() >= tc.max_cycles) break;
+      if (stop_requested(solver)) break;
+      solver.step([&] {
+        const double t = solver.time();
+        if (!output_due(t, loop)) return;
+        solver.gather_for_output();
+        if (t >= loop.next_history) loop.next_history += tc.history_interval;
+        if (t >= loop.next_frame) loop.next_frame += tc.frame_interval;
+      });
+    }
+    solver.gather_for_output();
+  } catch (const NumericalError&) {
+    return kNumericalFailure;
+  }
+  return kSuccess;
+}
+
 std::filesystem::path output_folder(const std::string& case_name, const RunOptions& o) {
   return o.out_dir.empty() ? std::filesystem::path("results") / case_name : o.out_dir;
 }
@@ -547,6 +599,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     write_figure_specs(r.dir, ec);
   }
   log_start(r);
+  if (options.resume && fem::PetscSession::size() > 1)
+    throw InputError(ec.file.string(), "--resume", "not yet on several MPI ranks (docs/parallel.md)");
 
   const auto solver_ptr = make_solver(ec, r);
   fem::ExplicitSolver& solver = *solver_ptr;

@@ -27,6 +27,9 @@ enum ExitCode : int { kSuccess = 0, kOtherError = 1, kBadInput = 2, kNumericalFa
 
 /// Runs the case; returns the exit code. Bad input found before the run throws InputError.
 int run_engine_case(EngineCase& ec, const RunOptions& options);
+/// The same run on an MPI rank other than the root (docs/parallel.md): it integrates its share and
+/// takes part in the root's output gathers; the root writes every file. Returns the exit code.
+int run_engine_worker(EngineCase& ec, const RunOptions& options);
 
 /// The folder a run (of any stage) writes to: options.out_dir, or results/<case name>.
 std::filesystem::path output_folder(const std::string& case_name, const RunOptions& options);

@@ -162,19 +162,19 @@ class ElementMeasure final : public fem::RunMeasure {
 class ContactResultants final : public fem::RunMeasure {
  public:
   void add_late_columns(const fem::ExplicitSolver& s, std::vector<std::string>& c) const override {
-    for (const auto& contact : s.model().contacts)
-      for (const auto& r : contact->resultants()) add_xyz(c, r.name + "_force", "N");
+    for (std::size_t k = 0; k < s.model().contacts.size(); ++k)
+      for (const auto& r : s.contact_resultants(k)) add_xyz(c, r.name + "_force", "N");
   }
   void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override {
-    for (const auto& contact : s.model().contacts)
-      for (const auto& r : contact->resultants())
+    for (std::size_t k = 0; k < s.model().contacts.size(); ++k)
+      for (const auto& r : s.contact_resultants(k))
         for (double v : r.force.arr()) row.push_back(v);
   }
   // Deepest penetration past the contact thickness over the run: a body passing through another
   // shows as a depth near its thickness.
   void add_summary(const fem::ExplicitSolver& s, nlohmann::json& summary) const override {
-    for (const auto& contact : s.model().contacts)
-      summary[contact->name() + "_max_penetration_m"] = contact->max_penetration();
+    for (std::size_t k = 0; k < s.model().contacts.size(); ++k)
+      summary[s.model().contacts[k]->name() + "_max_penetration_m"] = s.contact_max_penetration(k);
   }
 };
 

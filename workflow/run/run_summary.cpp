@@ -91,6 +91,29 @@ void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json
                          {"contact", tm.contact},
                          {"update", tm.update},
                          {"output", tm.output}};
+  // Several ranks (docs/parallel.md): each rank's share, so that load imbalance shows.
+  const auto& ranks = solver.rank_reports();
+  summary["mpi_ranks"] = ranks.empty() ? 1 : ranks.size();
+  if (!ranks.empty()) {
+    summary["timers_s"]["exchange"] = tm.exchange;
+    auto& per = summary["mpi_per_rank"] = nlohmann::json::array();
+    double busiest = 0;
+    for (const auto& r : ranks)
+      busiest = std::max(busiest, r.timers.internal_force + r.timers.contact + r.timers.update);
+    for (const auto& r : ranks) {
+      const double busy = r.timers.internal_force + r.timers.contact + r.timers.update;
+      per.push_back({{"elements", r.elements},
+                     {"owned_nodes", r.owned_nodes},
+                     {"ghost_nodes", r.ghost_nodes},
+                     {"ghost_bytes_per_cycle", r.ghost_bytes},
+                     {"timers_s",
+                      {{"internal_force", r.timers.internal_force},
+                       {"contact", r.timers.contact},
+                       {"update", r.timers.update},
+                       {"exchange", r.timers.exchange}}},
+                     {"busy_share", busiest > 0 ? busy / busiest : 1.0}});
+    }
+  }
 }
 
 namespace {

@@ -1,6 +1,8 @@
 #include "workflow/stages/stage_registry.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 #include "drape/case/kinematic_case.hpp"
 #include "fem/case/model_size.hpp"
@@ -21,7 +23,9 @@ namespace {
 int run_engine_stage(const StageCall& call) {
   EngineCase ec = load_engine_case(call.case_file, call.overrides);
   fem::PetscSession petsc;  // after the case: bad input is reported without starting MPI
-  if (const int code = refuse_many_ranks()) return code;
+  // Several ranks (docs/parallel.md): the root runs the case and writes its files, the others
+  // integrate their share.
+  if (fem::PetscSession::rank() != 0) return run_engine_worker(ec, call.options);
   return run_engine_case(ec, call.options);
 }
 
@@ -67,14 +71,20 @@ nlohmann::json stage_summary_header(const std::string& case_name, const StageCal
   return s;
 }
 
+int launcher_world_size() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MPI_LOCALNRANKS"})
+    if (const char* n = std::getenv(v)) return std::max(1, std::atoi(n));
+  return 1;
+}
+
 int refuse_many_ranks() {
   const int n = fem::PetscSession::size();
   if (n <= 1) return 0;
   if (fem::PetscSession::rank() == 0)
     std::fprintf(stderr,
-                 "ncfsim: bad input: started on %d MPI ranks, but the domain decomposition is not "
-                 "implemented yet (each rank would run the whole model and write the same files): "
-                 "start ncfsim without mpirun/mpiexec (one rank)\n",
+                 "ncfsim: bad input: started on %d MPI ranks: this command runs on one rank "
+                 "(only `ncfsim run` of engine and crush cases is split over ranks, "
+                 "docs/parallel.md): start it without --np / mpirun\n",
                  n);
   return kBadInput;
 }
@@ -137,6 +147,13 @@ int run_stage(const StageCall& call) {
     throw InputError(
         call.case_file.string(), "--resume",
         "a '" + kind + "' stage keeps no checkpoint (it is short): run it without --resume");
+  // Several ranks (docs/parallel.md): the time-loop runs only. Read from the launcher's
+  // environment: the other stages never start MPI.
+  if (kind != "engine" && kind != "crush" && launcher_world_size() > 1)
+    throw InputError(call.case_file.string(), "--np",
+                     "a '" + kind + "' stage runs on one MPI rank (only engine and crush cases " +
+                         "are split over ranks): run it without --np / mpirun, or give --np to " +
+                         "the stage cases themselves");
   return find_stage(kind, call.case_file).run(call);
 }
 

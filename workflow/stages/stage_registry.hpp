@@ -52,9 +52,12 @@ int check_stage(const StageCall& call);
 nlohmann::json stage_summary_header(const std::string& case_name, const StageCall& call,
                                     const std::string& stage);
 
-/// Until the domain decomposition lands the engine runs on one MPI rank: started by mpirun on
-/// more, every rank would run the whole model and write the same files. Returns the exit code
-/// (0: one rank); rank 0 says why. Needs an active PetscSession.
+/// For commands that run on one MPI rank only (checks, calibrations, workflows: only `run` of
+/// engine and crush cases is split over ranks, docs/parallel.md): started by mpirun on more,
+/// every rank would do the whole work and write the same files. Returns the exit code (0: one
+/// rank); rank 0 says why. Needs an active PetscSession.
 int refuse_many_ranks();
+/// The number of ranks the MPI launcher started (its environment; 1 outside a launcher).
+int launcher_world_size();
 
 }  // namespace ncfsim::workflow

@@ -1,0 +1,94 @@
+#pragma once
+// Domain decomposition of the explicit engine over MPI ranks (issue #24, docs/parallel.md).
+//
+// Every rank builds the whole model (mesh, groups, contacts, tools) with its nodal arrays at full
+// size and global node numbers, then integrates only its share:
+//  - elements: each group's elements, in the mesh's space-filling-curve (Morton) order, are cut
+//    into one contiguous run per rank of equal length (whole kernel chunks), so every rank gets
+//    the same share of every group (kind, part and material: balanced by element cost) and a
+//    compact piece of space; the kernels run over their run only;
+//  - nodes: a node is owned by the lowest rank holding an element on it (rank 0 for a node with
+//    no element); a rank updates its owned nodes only;
+//  - ghosts: the nodes a rank reads but does not own (the other corners of its elements, and what
+//    its contacts read: remote segments within the contact halo, tie masters, joint hexahedra).
+// Each cycle the forces at ghosts are added into their owners (one PetscSF reduce per force
+// array) and the owners' new positions and velocities are copied back to the ghosts (one PetscSF
+// broadcast each): the only nodal traffic, proportional to the partition surface.
+#include <mpi.h>
+#include <petscsf.h>
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace ncfsim::fem {
+
+class ElementGroup;
+struct Mesh;
+
+class Domain {
+ public:
+  /// The split of `groups` over the ranks of `comm`. `chunk(g)` is the kernel chunk of group g
+  /// (a run starts on a multiple of it).
+  Domain(MPI_Comm comm, std::size_t n_nodes,
+         const std::vector<std::unique_ptr<ElementGroup>>& groups);
+  ~Domain();
+  Domain(const Domain&) = delete;
+  Domain& operator=(const Domain&) = delete;
+
+  MPI_Comm comm() const { return comm_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  bool root() const { return rank_ == 0; }
+
+  /// [begin, end) of the elements of group g this rank integrates.
+  std::pair<std::size_t, std::size_t> range(std::size_t g) const { return range_[g]; }
+  /// [begin, end) of the elements of group g that rank r integrates.
+  std::pair<std::size_t, std::size_t> range(std::size_t g, int r) const;
+  bool owns(std::size_t node) const { return owner_[node] == rank_; }
+  int owner(std::size_t node) const { return owner_[node]; }
+  const std::vector<std::uint8_t>& owned_mask() const { return owned_; }
+  /// Runs [begin, end) of consecutive owned nodes.
+  const std::vector<std::pair<std::size_t, std::size_t>>& owned_runs() const { return runs_; }
+  std::size_t n_owned() const { return n_owned_; }
+
+  /// Nodes this rank reads (owned, corners of its elements, and those added by add_readable).
+  const std::vector<std::uint8_t>& readable_mask() const { return readable_; }
+  /// Marks more nodes as read by this rank (before finalise()).
+  void add_readable(std::span<const std::int32_t> nodes);
+  /// Builds the ghost exchange (collective). No add_readable after it.
+  void finalise();
+  std::size_t n_ghosts() const { return ghosts_.size(); }
+
+  /// Adds the ghost entries of a nodal array [3*n_nodes] into their owners' (collective). The
+  /// ghost entries are left as they were.
+  void add_ghosts_to_owners(double* a) const;
+  /// Copies the owners' entries of a nodal array to this rank's ghosts (collective).
+  void refresh_ghosts(double* a) const;
+  /// Copies every node's entries from its owner into the root's array (collective; the root's
+  /// array then holds the whole field; other ranks' arrays are not changed).
+  void gather_to_root(double* a) const;
+  /// Gathers each rank's run of group g's state array [components][n] into the root's.
+  void gather_group_array(std::size_t g, double* data, std::size_t n, int components) const;
+
+  /// Bytes this rank sends per cycle in the ghost exchange (two force arrays, x and v).
+  std::size_t ghost_bytes_per_cycle() const { return bytes_per_cycle_; }
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0, size_ = 1;
+  std::size_t n_nodes_ = 0, n_owned_ = 0, bytes_per_cycle_ = 0;
+  std::vector<std::pair<std::size_t, std::size_t>> range_;
+  std::vector<std::vector<std::pair<std::size_t, std::size_t>>> all_ranges_;  // [group][rank]
+  std::vector<int> owner_;
+  std::vector<std::uint8_t> owned_, readable_;
+  std::vector<std::pair<std::size_t, std::size_t>> runs_;
+  std::vector<std::int32_t> ghosts_;
+  PetscSF ghost_sf_ = nullptr;   // leaves: this rank's ghosts; roots: the owners' entries
+  PetscSF gather_sf_ = nullptr;  // leaves (root only): nodes the root does not own
+  MPI_Datatype node3_ = MPI_DATATYPE_NULL;
+};
+
+}  // namespace ncfsim::fem
