@@ -126,6 +126,20 @@ std::uint64_t spread_bits(std::uint64_t v) {  // 21 bits -> every third bit
   return v;
 }
 
+}  // namespace
+
+std::uint64_t morton_key(const std::array<double, 3>& c, const std::array<double, 3>& lo,
+                         const std::array<double, 3>& span) {
+  std::uint64_t key = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double t = span[k] > 0 ? (c[k] - lo[k]) / span[k] : 0.0;
+    key |= spread_bits(static_cast<std::uint64_t>(std::clamp(t, 0.0, 1.0) * 2097151.0)) << k;
+  }
+  return key;
+}
+
+namespace {
+
 std::vector<std::uint64_t> morton_keys(const Mesh& m, const ElementSet& s,
                                        const std::array<double, 3>& lo,
                                        const std::array<double, 3>& span) {
@@ -135,12 +149,7 @@ std::vector<std::uint64_t> morton_keys(const Mesh& m, const ElementSet& s,
     std::array<double, 3> c{0, 0, 0};
     for (auto v : s.nodes(e))
       for (int k = 0; k < 3; ++k) c[k] += m.coords[3 * static_cast<std::size_t>(v) + k] / nn;
-    std::uint64_t key = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double t = span[k] > 0 ? (c[k] - lo[k]) / span[k] : 0.0;
-      key |= spread_bits(static_cast<std::uint64_t>(std::clamp(t, 0.0, 1.0) * 2097151.0)) << k;
-    }
-    keys[e] = key;
+    keys[e] = morton_key(c, lo, span);
   }
   return keys;
 }
@@ -167,7 +176,10 @@ std::vector<std::int32_t> renumber_for_locality(Mesh& mesh) {
       lo[k] = std::min(lo[k], mesh.coords[3 * i + k]);
       hi[k] = std::max(hi[k], mesh.coords[3 * i + k]);
     }
-  std::array<double, 3> span{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+  // One scale for the three axes: the curve then runs through space evenly (a thin blanket is
+  // ordered in its plane, not layer by layer), which is also what the MPI split cuts along.
+  const double side = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  const std::array<double, 3> span{side, side, side};
 
   for (auto& s : mesh.sets) {
     auto keys = morton_keys(mesh, s, lo, span);

@@ -85,6 +85,10 @@ struct Mesh {
   }
 };
 
+/// Position of point c along the Morton curve of the box [lo, lo + span] (21 bits per axis): the
+/// order renumber_for_locality sorts elements in (by centroid, the box of all nodes).
+std::uint64_t morton_key(const std::array<double, 3>& c, const std::array<double, 3>& lo,
+                         const std::array<double, 3>& span);
 /// Reorders elements along a Morton curve of their centroids and renumbers nodes by first use.
 /// Returns the new-from-old node map (new_index = map[old_index]).
 std::vector<std::int32_t> renumber_for_locality(Mesh& mesh);

@@ -285,7 +285,20 @@ void ExplicitSolver::decompose() {
                            " elements: the model splits into at most " + std::to_string(most) +
                            " (one kernel chunk of 32 hexahedra or 256 bars per rank at least)");
   }
-  domain_ = std::make_unique<Domain>(PETSC_COMM_WORLD, model_.mesh.n_nodes(), groups_);
+  {
+    auto X0 = x0.view();
+    domain_ = std::make_unique<Domain>(PETSC_COMM_WORLD, model_.mesh.n_nodes(), X0.data(), groups_);
+  }
+  for (int r = 0; r < domain_->size(); ++r) {
+    std::size_t n_el = 0;
+    for (std::size_t g = 0; g < groups_.size(); ++g)
+      n_el += domain_->range(g, r).second - domain_->range(g, r).first;
+    if (n_el == 0)
+      throw InputError("", "--np",
+                       "rank " + std::to_string(r) + " of " + std::to_string(domain_->size()) +
+                           " gets no element (the model's elements come in too few kernel "
+                           "chunks of 32 hexahedra or 256 bars for so many ranks): fewer ranks");
+  }
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     const auto [b, e] = domain_->range(g);
     if (!groups_[g]->set_range(b, e))

@@ -3,10 +3,10 @@
 //
 // Every rank builds the whole model (mesh, groups, contacts, tools) with its nodal arrays at full
 // size and global node numbers, then integrates only its share:
-//  - elements: each group's elements, in the mesh's space-filling-curve (Morton) order, are cut
-//    into one contiguous run per rank of equal length (whole kernel chunks), so every rank gets
-//    the same share of every group (kind, part and material: balanced by element cost) and a
-//    compact piece of space; the kernels run over their run only;
+//  - elements: the Morton curve of the element centroids (the order the mesh sorts each part's
+//    elements in) is cut into one stretch per rank of equal element cost; each group's elements
+//    on a stretch are one contiguous run (to whole kernel chunks) that the kernels run over, and
+//    every group is cut at the same places in space, so the plies of a stack split together;
 //  - nodes: a node is owned by the lowest rank holding an element on it (rank 0 for a node with
 //    no element); a rank updates its owned nodes only;
 //  - ghosts: the nodes a rank reads but does not own (the other corners of its elements, and what
@@ -30,9 +30,8 @@ struct Mesh;
 
 class Domain {
  public:
-  /// The split of `groups` over the ranks of `comm`. `chunk(g)` is the kernel chunk of group g
-  /// (a run starts on a multiple of it).
-  Domain(MPI_Comm comm, std::size_t n_nodes,
+  /// The split of `groups` over the ranks of `comm`, at reference positions x0 [3*n_nodes].
+  Domain(MPI_Comm comm, std::size_t n_nodes, const double* x0,
          const std::vector<std::unique_ptr<ElementGroup>>& groups);
   ~Domain();
   Domain(const Domain&) = delete;

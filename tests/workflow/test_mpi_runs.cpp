@@ -7,8 +7,8 @@
 // last bits; energies are sums over ranks in another order. On an elastic model those differences
 // stay at round-off (below the 9 significant digits of history.csv: 1e-7 of a column's largest
 // value is asked); with frictional contact they grow
-// slowly with the number of stick-slip events, so a contact case is compared on its reactions and
-// energies (1e-4 of the largest value over 10 ms).
+// with the number of stick-slip events, so a contact case is compared on its reactions and
+// energies: 1e-6 of the largest value over the first 5 ms, 2e-3 over 10 ms.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -41,15 +41,19 @@ bool launcher_works() {
   return run_cli({"--version"}, {kMpiexec, "-n", "2"}).code == 0;
 }
 
-// Largest difference of column c between two histories, relative to the column's largest value.
-double relative_difference(const History& a, const History& b, const std::string& c) {
+// Largest difference of column c between two histories up to time t_end, relative to the
+// column's largest value.
+double relative_difference(const History& a, const History& b, const std::string& c,
+                           double t_end = 1e300) {
   const std::size_t ia = a.column(c), ib = b.column(c);
   EXPECT_LT(ia, a.columns.size()) << c;
   EXPECT_LT(ib, b.columns.size()) << c;
   if (ia >= a.columns.size() || ib >= b.columns.size()) return 1.0;
   EXPECT_EQ(a.rows.size(), b.rows.size());
   double scale = 0, diff = 0;
+  const std::size_t it = a.column("time");
   for (std::size_t r = 0; r < std::min(a.rows.size(), b.rows.size()); ++r) {
+    if (a.rows[r][it] > t_end) break;
     scale = std::max({scale, std::abs(a.rows[r][ia]), std::abs(b.rows[r][ib])});
     diff = std::max(diff, std::abs(a.rows[r][ia] - b.rows[r][ib]));
   }
@@ -100,15 +104,15 @@ void expect_rank_reports(const nlohmann::json& s) {
 
 }  // namespace
 
-// Erosion across ranks: two 4 x 4 x 4 cubes (64 hexahedra each, a 32-element chunk of each on
-// each rank), one crushed in uniaxial strain until its elements' steps fall below half: the same
-// elements erode at the same cycle on 2 ranks as on 1, with the same eroded energy and balance.
+// Erosion across ranks: a cube of 4 x 4 x 8 hexahedra (split between the ranks through its
+// height; its one-element neighbour goes with one of them), crushed in uniaxial strain until its
+// elements' steps fall below half: the same elements erode at the same cycle on 2 ranks as on 1,
+// on both ranks, with the same eroded energy and balance.
 TEST(MpiRuns, ErosionOnTwoRanksMatchesOneRank) {
   if (!launcher_works()) GTEST_SKIP() << "the MPI launcher does not start here";
   const TwoRuns t = run_on_one_and_two(
-      "mpi_erosion",
-      {(kSource / "tests/cases/erosion/crushed_cube.toml").string(), "--set",
-       "mesh.block[0].divisions=[4,4,4]", "--set", "mesh.block[1].divisions=[4,4,4]"});
+      "mpi_erosion", {(kSource / "tests/cases/erosion/crushed_cube.toml").string(), "--set",
+                      "mesh.block[0].divisions=[4,4,8]"});
   EXPECT_EQ(t.one["mpi_ranks"].get<int>(), 1);
   expect_rank_reports(t.two);
   EXPECT_EQ(t.two["status"], "completed");
@@ -135,9 +139,12 @@ TEST(MpiRunsContact, BiasCouponOnTwoRanksMatchesOneRank) {
                    "mesh.fabric[0].element_length=6.64e-3", "--set", "time.end_time=0.01"});
   expect_rank_reports(t.two);
   EXPECT_EQ(t.two["status"], "completed");
+  // Round-off at first, then amplified by friction's stick and slip (as between two builds).
   for (const char* c : {"pull_reaction_x_N", "pull_reaction_y_N", "internal_energy_J",
-                        "kinetic_energy_J", "contact_energy_J", "external_work_J"})
-    EXPECT_LT(relative_difference(t.h1, t.h2, c), 1e-4) << c;
+                        "kinetic_energy_J", "contact_energy_J", "external_work_J"}) {
+    EXPECT_LT(relative_difference(t.h1, t.h2, c, 0.005), 1e-6) << c;
+    EXPECT_LT(relative_difference(t.h1, t.h2, c), 2e-3) << c;
+  }
   EXPECT_NEAR(t.one["energy_balance_error"].get<double>(),
               t.two["energy_balance_error"].get<double>(), 1e-4);
 }
