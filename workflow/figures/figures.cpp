@@ -145,6 +145,7 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
   std::string why;
   if (!render::offscreen_rendering_available(&why))
     throw std::runtime_error("no off-screen rendering: " + why);
+  log.debug("off-screen rendering: {}", why);  // the back end (OSMesa, EGL) and its GL
   std::vector<std::filesystem::path> out;
   std::filesystem::create_directories(dir / "figures");
 
