@@ -657,17 +657,38 @@ V3 ExplicitSolver::reaction_force(const std::vector<std::int32_t>& nodes) const 
 void ExplicitSolver::check_finite(const double* vel) const {
   const std::size_t n = model_.mesh.n_nodes();
   auto X = x.view();
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(vel[3 * i + c])) {
+  std::string what;
+  for (std::size_t i = 0; i < n && what.empty(); ++i)
+    for (int c = 0; c < 3 && what.empty(); ++c)
+      if (!std::isfinite(vel[3 * i + c]) && (!domain_ || domain_->owns(i))) {
         std::ostringstream os;
         os << "numerical instability: velocity of node " << model_.mesh.node_user_id[i] << " at ("
            << X[3 * i] << ", " << X[3 * i + 1] << ", " << X[3 * i + 2]
            << ") m is not finite at t = " << t_ << " s, cycle " << cycle_
            << "; the stable step is controlled by " << element_noun(step_.kind) << " "
            << step_.element << " at " << element_position(step_, X.data());
-        throw NumericalError(os.str());
+        what = os.str();
       }
+  if (domain_) {
+    // The kinetic energy, summed over the ranks, told them all: each stops with the report of
+    // the rank that found the node.
+    if (what.empty()) what = "-";
+    share_blow_up(what);
+    throw NumericalError("numerical instability: a velocity is not finite");
+  }
+  if (!what.empty()) throw NumericalError(what);
+}
+
+void ExplicitSolver::share_blow_up(const std::string& what) const {
+  int from = what.empty() || what == "-" ? domain_->size() : domain_->rank();
+  MPI_Allreduce(MPI_IN_PLACE, &from, 1, MPI_INT, MPI_MIN, domain_->comm());
+  if (from == domain_->size()) return;  // no rank has one
+  std::string msg = what;
+  int len = static_cast<int>(msg.size());
+  MPI_Bcast(&len, 1, MPI_INT, from, domain_->comm());
+  msg.resize(static_cast<std::size_t>(len));
+  MPI_Bcast(msg.data(), len, MPI_CHAR, from, domain_->comm());
+  throw NumericalError(msg);
 }
 
 void ExplicitSolver::step(const std::function<void()>& at_tn) {
@@ -706,10 +727,17 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     {
       auto X0 = x0.view();
       const ElementCycleState cs{X.data(), Vv.data(), X0.data(), dt_prev_};
-      for (std::size_t k = 0; k < groups_.size(); ++k) {
+      std::string blow_up;  // several ranks: a kernel's blow-up report, shared below
+      for (std::size_t k = 0; k < groups_.size() && blow_up.empty(); ++k) {
         group_step_[k] = StableStep{};
-        groups_[k]->internal_forces(cs, fi, inc, group_step_[k]);
+        try {
+          groups_[k]->internal_forces(cs, fi, inc, group_step_[k]);
+        } catch (const NumericalError& e) {
+          if (!domain_) throw;
+          blow_up = e.what();
+        }
       }
+      if (domain_) share_blow_up(blow_up);
     }
     // Erosion: a step below the limit is seen at once; folded corners, which develop over many
     // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.

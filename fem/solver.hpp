@@ -161,6 +161,9 @@ class ExplicitSolver {
   void apply_mass_scaling();
   void assemble_mass();
   void check_finite(const double* vel) const;
+  /// Several ranks (collective): throws on every rank the NumericalError `what` of the lowest
+  /// rank whose `what` is a report (not empty, not "-"); returns when no rank has one.
+  void share_blow_up(const std::string& what) const;
   void build_motions();
   /// Erodes every element of the groups that can lose elements whose step at x (times the
   /// safety factor) is below dt_erode or one of whose corners has folded over (corner Jacobian
