@@ -286,7 +286,8 @@ void StitchToTowConnection::restrict_to_rank(const std::uint8_t* owned, const st
   slot_mine_.assign(slot_hex_.size(), 0);
   for (std::size_t i = 0; i < a_.size(); ++i) {
     joint_mine_[i] = owned[static_cast<std::size_t>(a_[i])];
-    if (joint_mine_[i] && joint_slot_[i] >= 0) slot_mine_[static_cast<std::size_t>(joint_slot_[i])] = 1;
+    if (joint_mine_[i] && joint_slot_[i] >= 0)
+      slot_mine_[static_cast<std::size_t>(joint_slot_[i])] = 1;
   }
 }
 

@@ -78,7 +78,8 @@ constexpr std::array<NodeUpdate, sizeof...(I)> node_update_table(std::index_sequ
 constexpr auto kNodeUpdates = node_update_table(std::make_index_sequence<16>{});
 
 // The node update over a rank's runs of owned nodes; the sums add up over the runs.
-NodeUpdateSums owned_node_update(NodeUpdate f, const std::vector<std::pair<std::size_t, std::size_t>>& runs,
+NodeUpdateSums owned_node_update(NodeUpdate f,
+                                 const std::vector<std::pair<std::size_t, std::size_t>>& runs,
                                  double alpha, double dt_mid, double dt_new, const double* inv_m,
                                  const double* mm, const double* fi, const double* fe,
                                  const double* fcon, double* vel, double* fdamp, double* x) {
@@ -359,8 +360,8 @@ void ExplicitSolver::gather_for_output() {
     std::vector<double> buf;
     for (const auto& r : res) buf.insert(buf.end(), {r.force.x, r.force.y, r.force.z});
     double pen = model_.contacts[k]->max_penetration();
-    MPI_Reduce(domain_->root() ? MPI_IN_PLACE : buf.data(), buf.data(), static_cast<int>(buf.size()),
-               MPI_DOUBLE, MPI_SUM, 0, domain_->comm());
+    MPI_Reduce(domain_->root() ? MPI_IN_PLACE : buf.data(), buf.data(),
+               static_cast<int>(buf.size()), MPI_DOUBLE, MPI_SUM, 0, domain_->comm());
     MPI_Reduce(domain_->root() ? MPI_IN_PLACE : &pen, &pen, 1, MPI_DOUBLE, MPI_MAX, 0,
                domain_->comm());
     for (std::size_t j = 0; j < res.size(); ++j) res[j].force = V3::at(&buf[3 * j]);
@@ -551,12 +552,12 @@ void ExplicitSolver::share_erosions(std::vector<std::int32_t>& gone,
   std::vector<double> mine;
   for (std::size_t q = 0; q < n_mine; ++q) {
     const ErosionEvent& ev = erosions_[erosions_.size() - n_mine + q];
-    mine.insert(mine.end(), {static_cast<double>(local_erosions_[q].first),
-                             static_cast<double>(local_erosions_[q].second),
-                             static_cast<double>(ev.cause), ev.time, static_cast<double>(ev.cycle),
-                             static_cast<double>(ev.element), static_cast<double>(ev.kind),
-                             static_cast<double>(ev.part), ev.step, ev.centroid.x, ev.centroid.y,
-                             ev.centroid.z});
+    mine.insert(mine.end(),
+                {static_cast<double>(local_erosions_[q].first),
+                 static_cast<double>(local_erosions_[q].second), static_cast<double>(ev.cause),
+                 ev.time, static_cast<double>(ev.cycle), static_cast<double>(ev.element),
+                 static_cast<double>(ev.kind), static_cast<double>(ev.part), ev.step, ev.centroid.x,
+                 ev.centroid.y, ev.centroid.z});
   }
   local_erosions_.clear();
   const int p = domain_->size();
@@ -564,7 +565,8 @@ void ExplicitSolver::share_erosions(std::vector<std::int32_t>& gone,
   int n = static_cast<int>(mine.size());
   MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, domain_->comm());
   int total = 0;
-  for (int r = 0; r < p; ++r) displs[static_cast<std::size_t>(r)] = total, total += counts[static_cast<std::size_t>(r)];
+  for (int r = 0; r < p; ++r)
+    displs[static_cast<std::size_t>(r)] = total, total += counts[static_cast<std::size_t>(r)];
   eroded_any_ = total > 0;
   if (total == 0) return;
   std::vector<double> all(static_cast<std::size_t>(total));
@@ -590,7 +592,7 @@ void ExplicitSolver::share_erosions(std::vector<std::int32_t>& gone,
                                              static_cast<std::size_t>(g.set_index(e))));
     const auto [b, end] = domain_->range(k);
     if (e >= b && e < end) continue;  // mine: done in erode()
-    g.erode(e);  // its energy was booked by the rank that integrates it
+    g.erode(e);                       // its energy was booked by the rank that integrates it
     for (int I = 0; I < g.nodes_per_element(); ++I) {
       const std::int32_t node = g.conn()[static_cast<std::size_t>(I) * g.size() + e];
       if (--node_elements_[static_cast<std::size_t>(node)] == 0) orphans.push_back(node);
@@ -850,8 +852,8 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     auto [ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke] =
         domain_ ? owned_node_update(kNodeUpdates[kind], domain_->owned_runs(), alpha, dt_mid,
                                     dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused)
-                : kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel,
-                                     fdamp, xfused);
+                : kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp,
+                                     xfused);
     // Works over the increments du_old = dt_prev v^{n-1/2}, du_new = dt_new v^{n+1/2}; kinetic
     // energy in product form: with the trapezoidal works, 1/2 v^{n-1/2} M v^{n+1/2} makes the
     // discrete energy balance of central differences exact for conservative forces.
@@ -913,7 +915,8 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       r.assign({ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke, inc.internal,
                 inc.stabilisation, inc.hourglass, inc.kinetic, energy_.internal - booked0[0],
                 energy_.eroded_internal - booked0[1], energy_.eroded_kinetic - booked0[2]});
-      for (const auto& tool : model_.tools) r.insert(r.end(), {tool.force.x, tool.force.y, tool.force.z});
+      for (const auto& tool : model_.tools)
+        r.insert(r.end(), {tool.force.x, tool.force.y, tool.force.z});
       MPI_Allreduce(MPI_IN_PLACE, r.data(), static_cast<int>(r.size()), MPI_DOUBLE, MPI_SUM,
                     domain_->comm());
       ext_old = r[0], ext_new = r[1], damp_old = r[2], damp_new = r[3], con_old = r[4],

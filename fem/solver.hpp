@@ -69,11 +69,11 @@ struct PhaseTimers {
 
 /// One MPI rank's share of a run (ExplicitSolver::rank_reports).
 struct RankReport {
-  std::size_t elements = 0;      // elements it integrates
-  std::size_t owned_nodes = 0;   // nodes it updates
-  std::size_t ghost_nodes = 0;   // nodes it reads from other ranks
-  std::size_t ghost_bytes = 0;   // bytes it sends per cycle in the ghost exchange
-  PhaseTimers timers;            // its phase times so far (output excluded)
+  std::size_t elements = 0;     // elements it integrates
+  std::size_t owned_nodes = 0;  // nodes it updates
+  std::size_t ghost_nodes = 0;  // nodes it reads from other ranks
+  std::size_t ghost_bytes = 0;  // bytes it sends per cycle in the ghost exchange
+  PhaseTimers timers;           // its phase times so far (output excluded)
 };
 
 class ExplicitSolver {

@@ -2,10 +2,11 @@
 // Exit codes: 0 success, 1 other error (incl. an interrupted run), 2 bad input, 3 numerical
 // failure.
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <cmath>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -13,7 +14,6 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "fem/errors.hpp"
@@ -69,8 +69,8 @@ int relaunch_with_mpiexec(int ranks, int argc, char** argv) {
   cargs.push_back(nullptr);
   std::fflush(nullptr);
   execvp(cargs[0], cargs.data());
-  std::fprintf(stderr, "ncfsim: bad input: --np %d: cannot start the MPI launcher '%s': %s\n", ranks,
-               args[0].c_str(), std::strerror(errno));
+  std::fprintf(stderr, "ncfsim: bad input: --np %d: cannot start the MPI launcher '%s': %s\n",
+               ranks, args[0].c_str(), std::strerror(errno));
   return wf::kBadInput;
 }
 

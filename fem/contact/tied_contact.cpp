@@ -311,7 +311,8 @@ bool TiedContact::nodes_to_read(const std::uint8_t* owned, const double*, double
 
 void TiedContact::restrict_to_rank(const std::uint8_t* owned, const std::uint8_t*) {
   mine_.assign(node_.size(), 0);
-  for (std::size_t t = 0; t < node_.size(); ++t) mine_[t] = owned[static_cast<std::size_t>(node_[t])];
+  for (std::size_t t = 0; t < node_.size(); ++t)
+    mine_[t] = owned[static_cast<std::size_t>(node_[t])];
 }
 
 void TiedContact::add_forces(const double* x, const double*, const double*, double, double* f) {

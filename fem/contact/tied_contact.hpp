@@ -81,7 +81,7 @@ class TiedContact final : public ContactAlgorithm {
   // and force of the last cycle; what a tie dissipated is its work less the energy it holds.
   std::vector<double> tie_work_, last_sep_, last_force_;
   double failed_work_ = 0;           // work done on the ties that have failed (all dissipated)
-  std::vector<std::uint8_t> mine_;  // several ranks: [n_tie] 1: its slave node is owned here
+  std::vector<std::uint8_t> mine_;   // several ranks: [n_tie] 1: its slave node is owned here
   std::vector<std::uint8_t> alive_;  // [n_tie] 1: holds, 2: holds until the next cycle (eroded)
   std::int64_t n_alive_ = 0;
   double dissipation_ = 0;

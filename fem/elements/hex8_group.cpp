@@ -48,8 +48,10 @@ class Hex8Group final : public ElementGroup {
   }
   std::vector<std::pair<double*, int>> state_arrays() override {
     const int nh = block.material->n_history();
-    std::vector<std::pair<double*, int>> a = {{block.stress.data(), 6},    {block.strain.data(), 6},
-                                              {block.hg_force.data(), 12}, {block.hg_viscous.data(), 12},
+    std::vector<std::pair<double*, int>> a = {{block.stress.data(), 6},
+                                              {block.strain.data(), 6},
+                                              {block.hg_force.data(), 12},
+                                              {block.hg_viscous.data(), 12},
                                               {block.volume.data(), 1}};
     if (nh > 0) a.emplace_back(block.history.data(), nh);
     return a;

@@ -17,9 +17,12 @@ namespace {
 // ~10 ns, a shell ~60 ns); contacts follow the elements' surface.
 double element_cost(ElementKind kind) {
   switch (kind) {
-    case ElementKind::Hex8: return 1.0;
-    case ElementKind::Bar2: return 0.05;
-    case ElementKind::Quad4: return 0.3;
+    case ElementKind::Hex8:
+      return 1.0;
+    case ElementKind::Bar2:
+      return 0.05;
+    case ElementKind::Quad4:
+      return 0.3;
   }
   return 1.0;
 }
@@ -34,7 +37,8 @@ std::vector<std::uint64_t> group_keys(const ElementGroup& g, const double* x0,
     std::array<double, 3> c{0, 0, 0};
     for (std::size_t I = 0; I < npe; ++I)
       for (int k = 0; k < 3; ++k)
-        c[k] += x0[3 * static_cast<std::size_t>(g.conn()[I * n + e]) + k] / static_cast<double>(npe);
+        c[k] +=
+            x0[3 * static_cast<std::size_t>(g.conn()[I * n + e]) + k] / static_cast<double>(npe);
     keys[e] = morton_key(c, lo, span);
   }
   return keys;
@@ -100,7 +104,8 @@ Domain::Domain(MPI_Comm comm, std::size_t n_nodes, const double* x0,
   lo.fill(std::numeric_limits<double>::max());
   hi.fill(std::numeric_limits<double>::lowest());
   for (std::size_t i = 0; i < n_nodes; ++i)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x0[3 * i + k]), hi[k] = std::max(hi[k], x0[3 * i + k]);
+    for (int k = 0; k < 3; ++k)
+      lo[k] = std::min(lo[k], x0[3 * i + k]), hi[k] = std::max(hi[k], x0[3 * i + k]);
   const double side = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
   span.fill(side);  // as Mesh::renumber_for_locality
   std::vector<std::vector<std::uint64_t>> keys;

@@ -600,7 +600,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   }
   log_start(r);
   if (options.resume && fem::PetscSession::size() > 1)
-    throw InputError(ec.file.string(), "--resume", "not yet on several MPI ranks (docs/parallel.md)");
+    throw InputError(ec.file.string(), "--resume",
+                     "not yet on several MPI ranks (docs/parallel.md)");
 
   const auto solver_ptr = make_solver(ec, r);
   fem::ExplicitSolver& solver = *solver_ptr;
