@@ -8,6 +8,11 @@
 //   HexInternalForceOnly/<material>      hex8_internal_forces alone on the same block;
 //                                        ".../l2_resident": a 2,048-element block whose state stays
 //                                        in L2 (the compute-bound figure, for reference)
+//   HexFullCycle/isotropic/ply_stack     the same on bench/cases/ply_stack_12.toml's mesh: 12 plies
+//                                        (parts) of 100x100x1 hexahedra of 1 x 1 x 0.25 mm, 120,000
+//                                        in all, 244,824 nodes (2.04 per hexahedron, the block
+//                                        1.06); x = 0 edge held; HexInternalForceOnly/.../ply_stack
+//                                        the kernel alone over its 12 blocks (issue #24)
 //   BarFullCycle                         full cycles of a 40x40x26-node lattice of 121,120
 //                                        tension-only bars, tabulated law, pre-stretched so that
 //                                        every segment of the table and slack bars occur
@@ -42,6 +47,7 @@ namespace {
 
 enum class Mat { Isotropic, Orthotropic, TowDamage };
 enum class Numbering { Local, RandomNodes, RandomAll };
+enum class Shape { Block, Small, PlyStack };
 
 constexpr std::array<int, 3> kHexDiv{60, 50, 40};        // 120,000 hexahedra, h = 10 mm
 constexpr std::array<int, 3> kSmallHexDiv{16, 16, 8};    // 2,048 hexahedra: state stays in L2
@@ -120,19 +126,27 @@ void set_velocity_field(fem::ExplicitSolver& s, double v0, bool noise) {
   // Fixed DOFs of the model are zeroed again by the first step.
 }
 
-Fixture& hex_fixture(Mat mat, Numbering num, bool small = false) {
-  const std::string key =
-      "hex" + std::to_string(int(mat)) + std::to_string(int(num)) + (small ? "s" : "");
+Fixture& hex_fixture(Mat mat, Numbering num, Shape shape = Shape::Block) {
+  const std::string key = "hex" + std::to_string(int(mat)) + std::to_string(int(num)) + "/" +
+                          std::to_string(int(shape));
   if (g_fixture && g_fixture->key == key) return *g_fixture;
   g_fixture.reset();
   auto fx = std::make_unique<Fixture>();
   fx->key = key;
   fem::Model& model = fx->model;
-  const int p = model.mesh.add_part("block");
-  const auto div = small ? kSmallHexDiv : kHexDiv;
-  fem::add_hex_block(model.mesh, p, {0, 0, 0}, {0.01 * div[0], 0.01 * div[1], 0.01 * div[2]}, div);
-  model.parts.resize(1);
-  model.parts[0].material = 0;
+  if (shape == Shape::PlyStack) {
+    for (int ply = 0; ply < 12; ++ply) {
+      const int p = model.mesh.add_part("ply" + std::to_string(ply));
+      fem::add_hex_block(model.mesh, p, {0, 0, ply * 0.25e-3}, {0.1, 0.1, 0.25e-3}, {100, 100, 1});
+    }
+  } else {
+    const int p = model.mesh.add_part("block");
+    const auto div = shape == Shape::Small ? kSmallHexDiv : kHexDiv;
+    fem::add_hex_block(model.mesh, p, {0, 0, 0}, {0.01 * div[0], 0.01 * div[1], 0.01 * div[2]},
+                       div);
+  }
+  model.parts.resize(model.mesh.part_names.size());
+  for (auto& part : model.parts) part.material = 0;
   if (mat == Mat::Isotropic) {
     model.materials.push_back(std::make_unique<fem::ElasticIsotropic>("steel", 7850.0, 210e9, 0.3));
   } else {
@@ -152,12 +166,13 @@ Fixture& hex_fixture(Mat mat, Numbering num, bool small = false) {
       model.materials.push_back(std::make_unique<impact::TowDamageMaterial>("cfrp_damage", d));
     }
     const double a = std::numbers::pi / 6, ca = std::cos(a), sa = std::sin(a);
-    model.parts[0].material_axes = {ca, -sa, 0, sa, ca, 0, 0, 0, 1};
+    for (auto& part : model.parts) part.material_axes = {ca, -sa, 0, sa, ca, 0, 0, 0, 1};
   }
   apply_numbering(model.mesh, num);
   std::vector<std::int32_t> base;
+  const int held_axis = shape == Shape::PlyStack ? 0 : 2;  // the stack: its x = 0 edge
   for (std::size_t i = 0; i < model.mesh.n_nodes(); ++i)
-    if (model.mesh.coords[3 * i + 2] < 1e-9) base.push_back(static_cast<std::int32_t>(i));
+    if (model.mesh.coords[3 * i + held_axis] < 1e-9) base.push_back(static_cast<std::int32_t>(i));
   model.fixed.push_back({"base", base, {true, true, true}});
   model.time.end_time = 1.0;
   fx->solver = std::make_unique<fem::ExplicitSolver>(model);
@@ -259,8 +274,8 @@ void report(benchmark::State& state, const std::string& name, const Timer& t,
                           static_cast<std::int64_t>(element_cycles_per_iteration));
 }
 
-void BM_HexFullCycle(benchmark::State& state, Mat mat, Numbering num) {
-  auto& fx = hex_fixture(mat, num);
+void BM_HexFullCycle(benchmark::State& state, Mat mat, Numbering num, Shape shape) {
+  auto& fx = hex_fixture(mat, num, shape);
   auto& s = *fx.solver;
   const Timer t;
   for (auto _ : state) s.step();
@@ -268,27 +283,29 @@ void BM_HexFullCycle(benchmark::State& state, Mat mat, Numbering num) {
   report(state, "ns_per_hex_cycle", t, s.n_elements(fem::ElementKind::Hex8));
 }
 
-void BM_HexInternalForceOnly(benchmark::State& state, Mat mat, bool small) {
-  auto& fx = hex_fixture(mat, Numbering::Local, small);
+void BM_HexInternalForceOnly(benchmark::State& state, Mat mat, Shape shape) {
+  auto& fx = hex_fixture(mat, Numbering::Local, shape);
   auto& s = *fx.solver;
-  auto& blk = s.blocks<fem::Hex8Block>().at(0);
+  const auto blocks = s.blocks<fem::Hex8Block>();
   auto X = s.x.view();
   auto V = s.v.view();
   auto F = s.f_int.view();
   const double dt = s.time_step();
-  const int reps = small ? 50 : 1;  // the small block: 50 calls per iteration
+  const int reps = shape == Shape::Small ? 50 : 1;  // the small block: 50 calls per iteration
   fem::ElementEnergyIncrement inc;
   const Timer t;
   for (auto _ : state) {
     for (int r = 0; r < reps; ++r) {
       fem::StableStep st;
       std::fill(F.data(), F.data() + F.size(), 0.0);
-      fem::hex8_internal_forces(blk, X.data(), V.data(), dt, F.data(), inc, st);
+      for (auto& blk : blocks)
+        fem::hex8_internal_forces(blk, X.data(), V.data(), dt, F.data(), inc, st);
       benchmark::DoNotOptimize(st.dt);
     }
   }
   benchmark::DoNotOptimize(inc.internal);
-  report(state, "ns_per_hex_cycle", t, blk.n * static_cast<std::size_t>(reps));
+  report(state, "ns_per_hex_cycle", t,
+         s.n_elements(fem::ElementKind::Hex8) * static_cast<std::size_t>(reps));
 }
 
 void BM_BarFullCycle(benchmark::State& state) {
@@ -329,31 +346,37 @@ void common(benchmark::internal::Benchmark* b, int iterations) {
 void register_all() {
   using benchmark::RegisterBenchmark;
   common(RegisterBenchmark("HexFullCycle/isotropic/local", BM_HexFullCycle, Mat::Isotropic,
-                           Numbering::Local),
+                           Numbering::Local, Shape::Block),
+         40);
+  common(RegisterBenchmark("HexFullCycle/isotropic/ply_stack", BM_HexFullCycle, Mat::Isotropic,
+                           Numbering::Local, Shape::PlyStack),
          40);
   common(RegisterBenchmark("HexFullCycle/orthotropic/local", BM_HexFullCycle, Mat::Orthotropic,
-                           Numbering::Local),
+                           Numbering::Local, Shape::Block),
          40);
   common(RegisterBenchmark("HexFullCycle/tow_damage/local", BM_HexFullCycle, Mat::TowDamage,
-                           Numbering::Local),
+                           Numbering::Local, Shape::Block),
          40);
   common(RegisterBenchmark("HexFullCycle/isotropic/random_nodes", BM_HexFullCycle, Mat::Isotropic,
-                           Numbering::RandomNodes),
+                           Numbering::RandomNodes, Shape::Block),
          40);
   common(RegisterBenchmark("HexFullCycle/isotropic/random_all", BM_HexFullCycle, Mat::Isotropic,
-                           Numbering::RandomAll),
+                           Numbering::RandomAll, Shape::Block),
          40);
   common(RegisterBenchmark("HexInternalForceOnly/isotropic", BM_HexInternalForceOnly,
-                           Mat::Isotropic, false),
+                           Mat::Isotropic, Shape::Block),
+         40);
+  common(RegisterBenchmark("HexInternalForceOnly/isotropic/ply_stack", BM_HexInternalForceOnly,
+                           Mat::Isotropic, Shape::PlyStack),
          40);
   common(RegisterBenchmark("HexInternalForceOnly/orthotropic", BM_HexInternalForceOnly,
-                           Mat::Orthotropic, false),
+                           Mat::Orthotropic, Shape::Block),
          40);
   common(RegisterBenchmark("HexInternalForceOnly/tow_damage", BM_HexInternalForceOnly,
-                           Mat::TowDamage, false),
+                           Mat::TowDamage, Shape::Block),
          40);
   common(RegisterBenchmark("HexInternalForceOnly/isotropic/l2_resident", BM_HexInternalForceOnly,
-                           Mat::Isotropic, true),
+                           Mat::Isotropic, Shape::Small),
          40);
   common(RegisterBenchmark("BarFullCycle", BM_BarFullCycle), 200);
   common(RegisterBenchmark("BarInternalForceOnly", BM_BarInternalForceOnly), 200);

@@ -693,8 +693,9 @@ void ExplicitSolver::share_blow_up(const std::string& what) const {
   throw NumericalError(msg);
 }
 
-void ExplicitSolver::step(const std::function<void()>& at_tn) {
+void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x) {
   const std::size_t n = model_.mesh.n_nodes(), nd = 3 * n;
+  const bool move_x_in_pass = !at_tn || !at_tn_reads_x;
   auto t0 = Clock::now();
   double dt_new = 0;
   {  // views are released before the callback, which may read the vectors itself
@@ -829,8 +830,9 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
 
     // v^{n+1/2}; works of each force kind over the increments around t^n.
     const double dt_mid = 0.5 * (dt_prev_ + dt_new);
-    // Without a callback the position update joins this loop (one pass over the nodal arrays).
-    double* xfused = at_tn ? nullptr : X.data();
+    // Unless the callback reads x^n the position update joins this loop (one pass over the
+    // nodal arrays).
+    double* xfused = move_x_in_pass ? X.data() : nullptr;
     const double* inv_m = inv_mass_.data();
     const double* fe = has_ext ? Fe.data() : zero_.data();
     const double* fcon = has_contact ? Fc.data() : zero_.data();
@@ -840,9 +842,18 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     const double* mm = M.data();
     // Constrained DOFs keep their v^{n-1/2} aside: the free update below runs over every DOF
     // without branches (it vectorises), then those DOFs are corrected.
+    // With the positions moved in the pass their x^n too, so that a held DOF ends at
+    // x^n + dt v^{n+1/2} exactly as in a separate position pass.
     for (std::size_t k = 0; k < constrained_.size(); ++k) constrained_vo_[k] = vel[constrained_[k]];
     freeing_vo_.resize(freeing_.size());
     for (std::size_t k = 0; k < freeing_.size(); ++k) freeing_vo_[k] = vel[freeing_[k]];
+    if (xfused) {
+      constrained_xo_.resize(constrained_.size());
+      for (std::size_t k = 0; k < constrained_.size(); ++k)
+        constrained_xo_[k] = xfused[constrained_[k]];
+      freeing_xo_.resize(freeing_.size());
+      for (std::size_t k = 0; k < freeing_.size(); ++k) freeing_xo_[k] = xfused[freeing_[k]];
+    }
     const double dtp = dt_prev_;
     // Without damping this cycle f_damp is left alone by the pass, so it is cleared once here.
     if (alpha == 0 && !f_damp_zero_) std::fill(fdamp, fdamp + nd, 0.0);
@@ -864,10 +875,10 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     for (auto& m : motions_) m->velocities(t_half, motion_v_.data());
     // Holds DOF d (v^{n-1/2} = vo, free v^{n+1/2} in vel) at velocity vp: the works of the forces
     // over the new increment and the kinetic energy are corrected; returns the reaction.
-    const auto hold = [&](std::size_t d, double vo, double vp) {
+    const auto hold = [&](std::size_t d, double vo, double vp, double xo) {
       const double m = mm[d], vfree = vel[d], dv = vp - vfree;
       vel[d] = vp;
-      if (xfused) xfused[d] += dt_new * dv;
+      if (xfused) xfused[d] = xo + dt_new * vp;
       ext_new += fe[d] * dt_new * dv;
       damp_new += fdamp[d] * dt_new * dv;
       con_new += fcon[d] * dt_new * dv;
@@ -884,7 +895,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
       } else if (code > 1) {
         vp = vpres[code - 2].arr()[d % 3];
       }
-      const double r = hold(d, vo, vp);
+      const double r = hold(d, vo, vp, xfused ? constrained_xo_[k] : 0.0);
       rr[d] = r;
       ext_old += r * dtp * vo;
       ext_new += r * dt_new * vp;
@@ -895,7 +906,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     for (std::size_t k = 0; k < freeing_.size(); ++k) {
       const std::size_t d = freeing_[k];
       const double vo = freeing_vo_[k];
-      energy_.eroded_kinetic -= 0.5 * hold(d, vo, 0.0) * dtp * vo;
+      energy_.eroded_kinetic -= 0.5 * hold(d, vo, 0.0, xfused ? freeing_xo_[k] : 0.0) * dtp * vo;
       inv_mass_[d] = 0;
     }
     freeing_.clear();
@@ -991,8 +1002,8 @@ void ExplicitSolver::step(const std::function<void()>& at_tn) {
     timers_.output += seconds_since(t0);
   }
 
-  // x^{n+1} (already done in the velocity loop when there is no callback)
-  if (at_tn) {
+  // x^{n+1} (already done in the velocity loop unless the callback reads x^n)
+  if (!move_x_in_pass) {
     auto X = x.view();
     auto Vv = v.view();
     if (domain_) {

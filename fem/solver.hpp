@@ -83,8 +83,10 @@ class ExplicitSolver {
   ~ExplicitSolver();
 
   /// One cycle. `at_tn` (may be empty) is called once state at t^n is complete (forces,
-  /// energies, v^{n+1/2}), before the positions move on to t^{n+1}.
-  void step(const std::function<void()>& at_tn = {});
+  /// energies, v^{n+1/2}), before the positions move on to t^{n+1}. With `at_tn_reads_x` false
+  /// the callback promises not to read x: the positions then move in the velocity pass (one
+  /// sweep over the nodal arrays, as without a callback), with the same results bit for bit.
+  void step(const std::function<void()>& at_tn = {}, bool at_tn_reads_x = true);
 
   double time() const { return t_; }
   double time_step() const { return dt_; }
@@ -195,6 +197,7 @@ class ExplicitSolver {
   std::size_t n_freed_nodes_ = 0;
   std::vector<std::size_t> freeing_;  // DOFs of nodes freed this cycle (stopped in its update)
   std::vector<double> freeing_vo_;    // their v^{n-1/2}
+  std::vector<double> freeing_xo_;    // their x^n (positions moved in the velocity pass)
   bool material_failure_ = false;     // a group's material can fail elements
   std::vector<double> step_scratch_, jacobian_scratch_;
   std::vector<double> reduce_buffer_;  // per-cycle sums over the ranks
@@ -219,6 +222,7 @@ class ExplicitSolver {
   bool has_motion_forces_ = false;
   std::vector<std::size_t> constrained_;  // DOFs with a fixed or prescribed velocity
   std::vector<double> constrained_vo_;    // their v^{n-1/2} during a cycle
+  std::vector<double> constrained_xo_;    // their x^n during a cycle (positions moved in the pass)
   std::vector<double> zero_;              // [3*n] zeros for force arrays a model does not use
   bool f_damp_zero_ = false;              // f_damp holds zeros (no damping since it was cleared)
   std::vector<double> inv_mass_;          // [3*n] 1 / lumped mass
