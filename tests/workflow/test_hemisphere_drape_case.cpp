@@ -1,19 +1,23 @@
 // Hemisphere forming of the +-45 NCF blanket (issue #18, the paper's Fig. 17-18), end to end on the
-// CI mesh: a 240 mm blank, one element across a tow, two tow pitches long (5.3k hexahedra, 10k
-// stitch bars, 41k stitch-to-tow joints), mass-scaled to 8e-7 s (36 % added to the tows; the
+// CI mesh: a 270 mm blank, one element across a tow, two tow pitches long (6.6k hexahedra, 12.8k
+// stitch bars, 51.9k stitch-to-tow joints), mass-scaled to 8e-7 s (36 % added to the tows; the
 // case's own 4e-7 s adds none). The acceptance of the issue: the punch reaches full depth (its
 // equator at the blankholder plane), the energy balance stays under 2 %, kinetic / internal under
 // 10 % over the forming, no tow passes through another or through a tool, the blankholder presses
 // with 3.35 kPa over the blank it covers, the ring measure is written with its four quadrant
 // maxima, and the punch force rises without ringing; the formed part transfers to the impregnated
-// model (issue #20). Bad input names the key.
+// model with no element lost (issue #20). Bad input names the key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "fem/io/stage_handoff.hpp"
 #include "tests/workflow/cli_test_support.hpp"
+#include "transfer/impregnation.hpp"
 
 namespace ncfsim::test {
 namespace {
@@ -54,8 +58,8 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   EXPECT_GE(s["punch_displacement_m"].get<double>(), 0.081);
   EXPECT_LT(s["energy_balance_error_max"].get<double>(), 0.02);
   EXPECT_LT(s["kinetic_to_internal_max"].get<double>(), 0.10);
-  // 3.35 kPa over the 240 mm square less the blankholder's 100 mm hole.
-  const double area = 0.24 * 0.24 - M_PI * 0.100 * 0.100;
+  // 3.35 kPa over the 270 mm square less the blankholder's 100 mm hole.
+  const double area = 0.27 * 0.27 - M_PI * 0.100 * 0.100;
   EXPECT_NEAR(s["blankholder_pressed_area_m2"].get<double>(), area, 1e-3 * area);
   EXPECT_NEAR(s["blankholder_applied_force_N"].get<double>(), 3350.0 * area, 1e-3 * 3350.0 * area);
   // No tow through a tool or through another: the deepest penetration over the run stays a small
@@ -63,24 +67,12 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   const double tow = s["fabrics"]["ncf"]["tow_thickness_m"];
   for (const char* tool : {"punch", "blankholder", "blankholder_edge", "die", "die_fillet"})
     EXPECT_LT(s[std::string(tool) + "_max_penetration_m"].get<double>(), 0.25 * tow) << tool;
-  // At the end of the stroke (from 95 % on in the run of 3 December 2026: the equator within
-  // 3.2 mm of the blankholder plane) the flat annulus between the punch and the die, drawn in and
-  // squeezed round the hoop, folds a few of this mesh's tow elements over the fillet's start (one
-  // element across a tow, 6.6 mm long: 17, 0.3 %, on the x axis) and the folded elements are
-  // eroded. With a margin for another machine's round-off (contact runs diverge late): none in the
-  // first 90 % of the stroke, at most 1 % of the elements.
+  // No tow element eroded (folded over or locked in compaction): every edge of the blank stays
+  // under the blankholder to full depth (docs/fabric-data.md, "Hemisphere forming: the CI blank";
+  // the 240 mm blank of before had its wale-axis edges drawn off it and into the die fillet in the
+  // last 5 % of the stroke, and 18 tow elements folded or locked there and were eroded).
   const std::size_t hexes = s["elements"]["hex8"];
-  EXPECT_LE(s["eroded_elements"].get<std::size_t>(), hexes / 100);
-  {
-    const auto h = read_history(out / "history.csv");
-    const auto d = h.column("punch_displacement_m"), n = h.column("eroded_elements");
-    ASSERT_LT(n, h.columns.size());
-    for (const auto& row : h.rows) {
-      if (row[d] < 0.90 * 0.0816) {
-        EXPECT_EQ(row[n], 0.0) << "erosion at punch travel " << row[d];
-      }
-    }
-  }
+  EXPECT_EQ(s["eroded_elements"].get<std::size_t>(), 0u);
   // The ring measure: four quadrant maxima, every azimuth on the formed fabric.
   for (int q = 1; q <= 4; ++q) {
     const auto& v = s["max_shear_deg_q" + std::to_string(q)];
@@ -115,22 +107,57 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   }
   EXPECT_LT(worst, 0.10 * f_end) << "punch force rings";
 
-  // The transfer of the formed part (issue #20): no element lost, Vf between the undeformed and
-  // the locking value, the plies and tows tied.
+  // The transfer of the formed part (issue #20): every tow element mapped (none eroded, none
+  // folded), each with an orthonormal, right-handed material frame and a positive Jacobian at
+  // every corner, Vf between the undeformed and the locking value, the plies and tows tied. The
+  // whole part is mapped with impregnation.min_corner_jacobian = 0 (every unfolded element): one
+  // tow on the die fillet (r = 86 mm, outside the crush's dome) ends at 0.07, under the default
+  // 0.1 that keeps strongly distorted tows out of a crush model (docs/fabric-data.md, "Hemisphere
+  // forming: the CI blank"); the dome the workflow transfers for the crush loses none at 0.1.
+  {
+    const auto ds = nlohmann::json::parse(slurp(wf / "transfer" / "summary.json"));
+    EXPECT_EQ(ds["elements_lost"].get<std::size_t>(), 0u);
+    EXPECT_GT(ds["elements_mapped"].get<std::size_t>(), hexes / 4);
+  }
   const fs::path tr = wf / "transfer_full";
   const auto tr_run =
       run_cli({"-q", "run", (kSource / "cases/hemisphere/transfer.toml").string(), "-o",
-               tr.string(), "--set", "source.results=" + (out / "results.h5").string()});
+               tr.string(), "--set", "source.results=" + (out / "results.h5").string(), "--set",
+               "impregnation.min_corner_jacobian=0.0"});
   ASSERT_EQ(tr_run.code, 0) << tr_run.output;
   const auto ts = nlohmann::json::parse(slurp(tr / "summary.json"));
-  // Every tow element that was not eroded (an eroded one has no shape to map) nor folded over a
-  // tool edge (a handful: a folded impregnated tow would make the crush unstable).
-  EXPECT_EQ(
-      ts["elements_lost"].get<std::size_t>(),
-      s["eroded_elements"].get<std::size_t>() + ts["elements_lost_distorted"].get<std::size_t>());
-  EXPECT_LE(ts["elements_lost_distorted"].get<std::size_t>(), hexes / 200);
-  EXPECT_EQ(ts["elements_mapped"].get<std::size_t>() + ts["elements_lost"].get<std::size_t>(),
-            hexes);
+  EXPECT_EQ(ts["elements_lost"].get<std::size_t>(), 0u);
+  EXPECT_EQ(ts["elements_mapped"].get<std::size_t>(), hexes);
+  {
+    const auto model = fem::io::read_last_frame(tr / "results.h5");
+    ASSERT_EQ(model.mesh.n_hex(), hexes);
+    const auto* a1 = model.field("fibre_direction");
+    const auto* a2 = model.field("material_axis_2");
+    const auto* a3 = model.field("material_axis_3");
+    ASSERT_TRUE(a1 && a2 && a3);
+    auto axis = [](const fem::io::FrameField* f, std::size_t e) {
+      return fem::V3{f->values[3 * e], f->values[3 * e + 1], f->values[3 * e + 2]};
+    };
+    double worst_corner = 1.0;
+    for (std::size_t e = 0; e < hexes; ++e) {
+      const fem::V3 u = axis(a1, e), v = axis(a2, e), w = axis(a3, e);
+      ASSERT_NEAR(fem::dot(u, u), 1.0, 1e-9) << e;
+      ASSERT_NEAR(fem::dot(v, v), 1.0, 1e-9) << e;
+      ASSERT_NEAR(fem::dot(w, w), 1.0, 1e-9) << e;
+      ASSERT_NEAR(fem::dot(u, v), 0.0, 1e-9) << e;
+      ASSERT_NEAR(fem::dot(u, w), 0.0, 1e-9) << e;
+      ASSERT_NEAR(fem::dot(v, w), 0.0, 1e-9) << e;
+      ASSERT_NEAR(fem::dot(fem::cross(u, v), w), 1.0, 1e-9) << e;
+      std::array<fem::V3, 8> x;
+      for (std::size_t a = 0; a < 8; ++a) {
+        const auto n = static_cast<std::size_t>(model.mesh.hex8[8 * e + a]);
+        x[a] = fem::V3{model.coordinates[3 * n], model.coordinates[3 * n + 1],
+                       model.coordinates[3 * n + 2]};
+      }
+      worst_corner = std::min(worst_corner, transfer::min_scaled_corner_jacobian(x));
+    }
+    EXPECT_GT(worst_corner, 0.0) << "a folded impregnated element";
+  }
   EXPECT_GE(ts["vf_min"].get<double>(), 0.6 - 1e-12);
   EXPECT_LE(ts["vf_max"].get<double>(), 0.857 + 1e-12);
   EXPECT_GT(ts["vf_max"].get<double>(), 0.65) << "the flange's compaction shows";
