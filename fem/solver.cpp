@@ -926,6 +926,10 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
       r.assign({ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke, inc.internal,
                 inc.stabilisation, inc.hourglass, inc.kinetic, energy_.internal - booked0[0],
                 energy_.eroded_internal - booked0[1], energy_.eroded_kinetic - booked0[2]});
+      double fr_rank = 0;  // friction dissipated so far, this rank's share
+      for (const auto& tool : model_.tools) fr_rank += tool.friction_dissipation;
+      for (const auto& c : model_.contacts) fr_rank += c->friction_dissipation();
+      r.push_back(fr_rank);
       for (const auto& tool : model_.tools)
         r.insert(r.end(), {tool.force.x, tool.force.y, tool.force.z});
       MPI_Allreduce(MPI_IN_PLACE, r.data(), static_cast<int>(r.size()), MPI_DOUBLE, MPI_SUM,
@@ -938,8 +942,9 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
       energy_.stabilisation += r[8];
       energy_.hourglass += r[9];
       energy_.rotational_kinetic += r[10];
+      friction_all_ranks_ = r[14];
       for (std::size_t k = 0; k < model_.tools.size(); ++k)
-        model_.tools[k].force = {r[14 + 3 * k], r[15 + 3 * k], r[16 + 3 * k]};
+        model_.tools[k].force = {r[15 + 3 * k], r[16 + 3 * k], r[17 + 3 * k]};
       timers_.exchange += seconds_since(tr);
     }
     w_ext_.add(ext_old, ext_new);
@@ -989,8 +994,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
     double fr = 0;
     for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
     for (const auto& c : model_.contacts) fr += c->friction_dissipation();
-    if (domain_) MPI_Allreduce(MPI_IN_PLACE, &fr, 1, MPI_DOUBLE, MPI_SUM, domain_->comm());
-    energy_.friction = fr;
+    energy_.friction = domain_ ? friction_all_ranks_ : fr;
     energy_.scale_max = std::max(energy_.scale_max, energy_.scale());
     if (!std::isfinite(ke)) check_finite(Vv.data());
     timers_.update += seconds_since(t0);

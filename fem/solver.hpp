@@ -202,7 +202,8 @@ class ExplicitSolver {
   std::vector<double> step_scratch_, jacobian_scratch_;
   std::vector<double> reduce_buffer_;  // per-cycle sums over the ranks
   std::vector<std::pair<std::size_t, std::size_t>> local_erosions_;  // (group, element) this cycle
-  bool eroded_any_ = false;  // several ranks: some rank eroded an element this cycle
+  bool eroded_any_ = false;
+  double friction_all_ranks_ = 0;  // several ranks: friction dissipated, summed this cycle  // several ranks: some rank eroded an element this cycle
   std::vector<std::vector<ContactResultant>> contact_resultants_;  // several ranks: summed
   std::vector<double> contact_max_penetration_;
   std::vector<RankReport> rank_reports_;

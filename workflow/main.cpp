@@ -14,6 +14,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fem/errors.hpp"
@@ -63,7 +64,9 @@ int relaunch_with_mpiexec(int ranks, int argc, char** argv) {
   }
   ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
   ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
-  ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
+  // Oversubscribed, Open MPI yields the core while it waits (slower messages): only then.
+  if (static_cast<unsigned>(ranks) > std::thread::hardware_concurrency())
+    ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
   std::vector<char*> cargs;
   for (auto& a : args) cargs.push_back(a.data());
   cargs.push_back(nullptr);
