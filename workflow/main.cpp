@@ -38,13 +38,6 @@ namespace wf = ncfsim::workflow;
 
 namespace {
 
-// Whether this process was started by an MPI launcher (Open MPI, MPICH/Hydra, Slurm's PMI).
-bool under_mpi_launcher() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS"})
-    if (std::getenv(v)) return true;
-  return false;
-}
-
 // `ncfsim run ... --np N` outside a launcher: starts N ranks of this same executable with the
 // launcher CMake found, the same arguments less --np (docs/cli.md). Open MPI refuses to run as
 // root and more ranks than cores unless told: both allowed here, as the user asked for N.
@@ -320,7 +313,7 @@ int main(int argc, char** argv) {
       return wf::check_stage(call);
     }
     if (*run) {  // [case] kind -> its stage (workflow/stages/stage_registry.hpp)
-      if (ranks > 1 && !under_mpi_launcher()) return relaunch_with_mpiexec(ranks, argc, argv);
+      if (ranks > 1 && !wf::started_by_mpi_launcher()) return relaunch_with_mpiexec(ranks, argc, argv);
       wf::StageCall call;
       call.case_file = case_file;
       call.overrides = overrides;

@@ -71,8 +71,20 @@ nlohmann::json stage_summary_header(const std::string& case_name, const StageCal
   return s;
 }
 
+namespace {
+// What the launchers (Open MPI, MPICH/Hydra, Slurm's PMI) put in a rank's environment: the
+// world size.
+constexpr const char* kLauncherSizeVars[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MPI_LOCALNRANKS"};
+}  // namespace
+
+bool started_by_mpi_launcher() {
+  for (const char* v : kLauncherSizeVars)
+    if (std::getenv(v)) return true;
+  return false;
+}
+
 int launcher_world_size() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MPI_LOCALNRANKS"})
+  for (const char* v : kLauncherSizeVars)
     if (const char* n = std::getenv(v)) return std::max(1, std::atoi(n));
   return 1;
 }

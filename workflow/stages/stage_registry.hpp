@@ -57,6 +57,8 @@ nlohmann::json stage_summary_header(const std::string& case_name, const StageCal
 /// every rank would do the whole work and write the same files. Returns the exit code (0: one
 /// rank); rank 0 says why. Needs an active PetscSession.
 int refuse_many_ranks();
+/// Whether an MPI launcher started this process (its environment), on any number of ranks.
+bool started_by_mpi_launcher();
 /// The number of ranks the MPI launcher started (its environment; 1 outside a launcher).
 int launcher_world_size();
 
