@@ -1,5 +1,8 @@
 #include "fem/petsc_vector.hpp"
 
+#include <cstdlib>
+#include <exception>
+
 namespace ncfsim::fem {
 
 PetscSession::PetscSession(int* argc, char*** argv) {
@@ -14,7 +17,16 @@ PetscSession::PetscSession(int* argc, char*** argv) {
 }
 
 PetscSession::~PetscSession() {
-  if (owns_) PetscFinalize();
+  if (!owns_) return;
+  // Left by an exception on several ranks (bad input every rank finds, e.g. a model that cannot
+  // be split): the root reports it only after this scope, and MPI_Finalize lets the other ranks
+  // exit, upon which the launcher ends the job, the root with it, often before its message was
+  // out. Finalizing at process exit keeps every rank until the root has printed.
+  if (std::uncaught_exceptions() > 0 && size() > 1) {
+    std::atexit([] { PetscFinalize(); });
+    return;
+  }
+  PetscFinalize();
 }
 
 bool PetscSession::active() {

@@ -19,27 +19,12 @@
 #include <vector>
 
 #include "tests/workflow/cli_test_support.hpp"
+#include "tests/workflow/mpi_test_support.hpp"
 
 namespace fs = std::filesystem;
 using namespace ncfsim::test;
 
 namespace {
-
-const std::string kMpiexec = NCFSIM_MPIEXEC;
-
-// Open MPI refuses root and more ranks than cores unless told (ncfsim run --np sets these
-// itself; a test that calls the launcher directly must too).
-void allow_launcher() {
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-  ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
-}
-
-bool launcher_works() {
-  if (kMpiexec.empty() || !fs::exists(kMpiexec)) return false;
-  allow_launcher();
-  return run_cli({"--version"}, {kMpiexec, "-n", "2"}).code == 0;
-}
 
 // Largest difference of column c between two histories up to time t_end, relative to the
 // column's largest value.
