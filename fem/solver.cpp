@@ -274,7 +274,6 @@ void ExplicitSolver::decompose() {
   const auto refuse = [](const std::string& key, const std::string& what) {
     throw InputError("", key, what + " cannot run on several MPI ranks yet: run it with --np 1");
   };
-  if (!model_.picture_frames.empty()) refuse("picture_frame", "a picture-frame rig");
   {  // a rank must integrate something: at most one rank per kernel chunk of the largest group
     std::size_t most = 0, n_el = 0;
     for (const auto& g : groups_) most = std::max(most, (g->size() + g->chunk() - 1) / g->chunk());
@@ -352,6 +351,18 @@ void ExplicitSolver::gather_for_output() {
                                static_cast<std::size_t>(a[2]), static_cast<std::size_t>(a[3]),
                                PhaseTimers{a[4], a[5], a[6], 0.0, a[7]}});
     }
+  }
+  if (frames_) {  // the walls' power and contacts of each frame, summed over the ranks
+    const std::size_t nf = model_.picture_frames.size();
+    std::vector<double> buf(2 * nf);
+    for (std::size_t k = 0; k < nf; ++k)
+      buf[k] = frames_->wall_power(k), buf[nf + k] = static_cast<double>(frames_->wall_contacts(k));
+    MPI_Reduce(domain_->root() ? MPI_IN_PLACE : buf.data(), buf.data(),
+               static_cast<int>(buf.size()), MPI_DOUBLE, MPI_SUM, 0, domain_->comm());
+    frame_wall_power_.assign(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(nf));
+    frame_wall_contacts_.clear();
+    for (std::size_t k = 0; k < nf; ++k)
+      frame_wall_contacts_.push_back(static_cast<std::int64_t>(buf[nf + k]));
   }
   contact_resultants_.resize(model_.contacts.size());
   contact_max_penetration_.resize(model_.contacts.size());
@@ -431,6 +442,14 @@ void ExplicitSolver::build_motions() {
     motions_.push_back(std::move(pf));
   }
   for (const auto& m : motions_) m->check(n);
+  // Several ranks: a node meets the arms (walls) on the rank that owns it, as it meets a tool;
+  // the rig's wall work and power are summed over the ranks (step, gather_for_output). Each
+  // rank's motion was told it has walls from the whole lists (the ranks take the same branches).
+  if (domain_)
+    for (auto& pf : model_.picture_frames)
+      for (auto& w : pf.walls)
+        std::erase_if(w,
+                      [&](std::int32_t i) { return !domain_->owns(static_cast<std::size_t>(i)); });
   // Driven nodes: code 254; the owning (motion, set) of each kept to bind its DOFs below.
   std::vector<std::pair<std::int32_t, std::int32_t>> owner(n, {-1, -1});
   for (std::size_t m = 0; m < motions_.size(); ++m)
@@ -456,9 +475,11 @@ void ExplicitSolver::build_motions() {
 }
 
 double ExplicitSolver::frame_wall_power(std::size_t k) const {
+  if (domain_) return k < frame_wall_power_.size() ? frame_wall_power_[k] : 0.0;
   return frames_ ? frames_->wall_power(k) : 0.0;
 }
 std::int64_t ExplicitSolver::frame_wall_contacts(std::size_t k) const {
+  if (domain_) return k < frame_wall_contacts_.size() ? frame_wall_contacts_[k] : 0;
   return frames_ ? frames_->wall_contacts(k) : 0;
 }
 
@@ -932,6 +953,13 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
       r.push_back(fr_rank);
       for (const auto& tool : model_.tools)
         r.insert(r.end(), {tool.force.x, tool.force.y, tool.force.z});
+      // The rigs' walls push this rank's nodes: their work (rig and on the nodes) is its share.
+      std::array<double, 4> mw = {0, 0, 0, 0};
+      for (auto& m : motions_)
+        if (m->has_forces())
+          m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, mw[0], mw[1], mw[2],
+                            mw[3]);
+      if (has_motion_forces_) r.insert(r.end(), mw.begin(), mw.end());
       MPI_Allreduce(MPI_IN_PLACE, r.data(), static_cast<int>(r.size()), MPI_DOUBLE, MPI_SUM,
                     domain_->comm());
       ext_old = r[0], ext_new = r[1], damp_old = r[2], damp_new = r[3], con_old = r[4],
@@ -945,6 +973,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
       friction_all_ranks_ = r[14];
       for (std::size_t k = 0; k < model_.tools.size(); ++k)
         model_.tools[k].force = {r[15 + 3 * k], r[16 + 3 * k], r[17 + 3 * k]};
+      if (has_motion_forces_) std::copy(r.end() - 4, r.end(), motion_work_all_ranks_.begin());
       timers_.exchange += seconds_since(tr);
     }
     w_ext_.add(ext_old, ext_new);
@@ -979,10 +1008,16 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
     }
     // Rigs' walls: driven like velocity tools, so their work on the nodes is the rig's (external)
     // work; the contact energy keeps the penalty energy stored.
-    for (auto& m : motions_)
-      if (m->has_forces())
-        m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, tool_src_old, tool_src_new,
-                          tool_on_nodes_old, tool_on_nodes_new);
+    if (!domain_) {
+      for (auto& m : motions_)
+        if (m->has_forces())
+          m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, tool_src_old,
+                            tool_src_new, tool_on_nodes_old, tool_on_nodes_new);
+    } else if (has_motion_forces_) {  // summed over the ranks above
+      const auto& mw = motion_work_all_ranks_;
+      tool_src_old += mw[0], tool_src_new += mw[1];
+      tool_on_nodes_old += mw[2], tool_on_nodes_new += mw[3];
+    }
     w_tools_.add(tool_src_old, tool_src_new);
     tool_work_on_nodes_.add(tool_on_nodes_old, tool_on_nodes_new);
 

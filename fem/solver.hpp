@@ -2,6 +2,7 @@
 // Central-difference explicit time integration with a variable stable step, on nodal state held
 // in PETSc vectors. The model is checked and all element groups built before the first cycle;
 // the cycle itself only computes.
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -206,6 +207,9 @@ class ExplicitSolver {
   double friction_all_ranks_ = 0;  // several ranks: friction dissipated, summed this cycle  // several ranks: some rank eroded an element this cycle
   std::vector<std::vector<ContactResultant>> contact_resultants_;  // several ranks: summed
   std::vector<double> contact_max_penetration_;
+  std::array<double, 4> motion_work_all_ranks_{};  // several ranks: the rigs' wall works, summed
+  std::vector<double> frame_wall_power_;           // several ranks: summed at gather_for_output
+  std::vector<std::int64_t> frame_wall_contacts_;
   std::vector<RankReport> rank_reports_;
   /// Elements eroded this cycle: their nodes and nodal internal forces at t^n. Their work over the
   /// first half of the next increment, which the trapezoidal external work counts, is booked

@@ -13,7 +13,9 @@
 // Tolerances. The scale of a column is its largest magnitude over both runs; a component of a
 // vector (columns <name>_x_<unit>, _y_, _z_) takes its vector's (the largest of the three: a
 // small component of a contact resultant is what is left of large contributions), and
-// energy_balance_error, already a fraction of the energy scale, is compared absolutely.
+// energy_balance_error, already a fraction of the energy scale, is compared absolutely; and no
+// column with a unit (_N, _J, _m, _deg, _N_per_m) has a scale below a millionth of the largest
+// of its unit (a resultant that stays zero in an in-plane test is round-off of the others).
 //  - kRoundOff = 1e-7: on 2 ranks a rank sums its own elements' and contacts' forces at a
 //    partition-boundary node and the exchange adds the other rank's share; energies, works,
 //    tool forces and friction are sums over the ranks: the same numbers summed in another
@@ -28,14 +30,17 @@
 //    contact resultant; the one-rank run with its safety factor moved by one ulp (0.9 ->
 //    0.9000000000000001) differs from itself by the same 2e-5, so this is round-off amplified,
 //    not the partition.
+//  - The stitched picture frames are chaotic past 14 deg of shear: see kFrameLate.
 // The largest difference of each case, with its column, is printed by the test.
 #include <gtest/gtest.h>
 #include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -56,13 +61,20 @@ struct Compared {
   std::string file;               // under cases/
   std::vector<std::string> sets;  // its CI size and a bounded run (--set)
   double tolerance;               // of a column's scale (above)
+  // Chaotic cases: every column is compared up to `until` (s); after it only `late_columns`,
+  // within `late_tolerance` (see kFrameLate).
+  double until = 1e300;
+  std::vector<std::string> late_columns = {};
+  double late_tolerance = 0;
 };
+void PrintTo(const Compared& c, std::ostream* os) { *os << c.file; }
 
 // A case that cannot be split today: `--np 2` exits 2 and the message holds `reason`.
 struct Refused {
   std::string file;
   std::string reason;
 };
+void PrintTo(const Refused& c, std::ostream* os) { *os << c.file; }
 
 // A case compared through another entry (the same case at its CI size).
 struct Covered {
@@ -88,6 +100,21 @@ const std::vector<std::string> kHemisphereCi = {"mesh.fabric[0].elements_across_
 // The friction sleds at their regression test's coarse mesh, 10 ms (pressed, then pulled).
 const std::vector<std::string> kSled = {"mesh.resolution=coarse", "time.end_time=0.01",
                                         "time.history_interval=1e-4"};
+// The picture frames sheared to their 52 deg in 6 ms instead of 57.4 ms (the frame reaches its
+// final angle at the end time; the ramp stays 5 ms).
+const std::vector<std::string> kFrame6ms = {"time.end_time=0.006", "time.history_interval=6e-5"};
+// The stitched frames are chaotic once the tows meet (about 14 deg, 3.3 ms here): stick-slip at
+// the tow-tow contacts and the stitch-to-tow joints lets a last-bit difference grow a
+// hundredfold every 0.3 ms, to 1e-3 of the frame force and a few tenths of the joints' resultant
+// at 52 deg. The one-rank run with its safety factor moved by one ulp wanders off as far (8e-4
+// of the frame force, the joints' resultant by its whole size): chaos, not the partition. So
+// every column is compared up to 2.8 ms (10 deg; measured 1.7e-5 positive, 7.6e-7 negative),
+// and over the whole run the frame's normalised shear force (the case's result) and the
+// energies within 1e-2 (measured 2.3e-3, 2.2e-3).
+constexpr double kFrameUntil = 2.8e-3;
+constexpr double kFrameLate = 1e-2;
+const std::vector<std::string> kFrameLateColumns = {"frame_normalised_shear_force_N_per_m",
+                                                    "internal_energy_J", "external_work_J"};
 
 const std::vector<Compared>& compared() {
   static const std::vector<Compared> c = {
@@ -106,6 +133,12 @@ const std::vector<Compared>& compared() {
        {"time.end_time=0.0012", "time.history_interval=1.2e-5", "time.quasi_static_from=0"},
        kRoundOff},
       {"hemisphere/drape_no_stitch.toml", kHemisphereCi, kRoundOff},
+      // The frame's arms as walls push the edge tows of both ranks (measured: equal bit for bit).
+      {"drape/picture_frame_unstitched.toml", kFrame6ms, kRoundOff},
+      {"drape/picture_frame_positive.toml", kFrame6ms, kStickSlip, kFrameUntil, kFrameLateColumns,
+       kFrameLate},
+      {"drape/picture_frame_negative.toml", kFrame6ms, kStickSlip, kFrameUntil, kFrameLateColumns,
+       kFrameLate},
       // The default 20 hexahedra are one kernel chunk (one rank at most): the fine mesh's 40.
       {"verification/cantilever.toml",
        {"mesh.resolution=fine", "time.end_time=0.004", "time.history_interval=4e-5"},
@@ -115,7 +148,6 @@ const std::vector<Compared>& compared() {
 }
 
 const std::string kShells = "a part of shell elements cannot run on several MPI ranks yet";
-const std::string kFrame = "a picture-frame rig cannot run on several MPI ranks yet";
 const std::string kOneElement = "2 MPI ranks for 1 elements";
 
 const std::vector<Refused>& refused() {
@@ -123,16 +155,12 @@ const std::vector<Refused>& refused() {
       // Shells: their nodal rotations would need their own exchange (docs/parallel.md).
       {"drape/macro/bias_extension_negative.toml", kShells},
       {"drape/macro/bias_extension_positive.toml", kShells},
-      {"drape/macro/picture_frame.toml", kFrame},
-      {"drape/macro/picture_frame_negative.toml", kFrame},
+      {"drape/macro/picture_frame.toml", kShells},
+      {"drape/macro/picture_frame_negative.toml", kShells},
       {"hemisphere/drape_macro.toml", kShells},
       {"hemisphere/drape_macro_signed.toml", kShells},
       {"hemisphere/ci/drape_macro.toml", kShells},
       {"verification/shell_cantilever.toml", kShells},
-      // Picture-frame rigs.
-      {"drape/picture_frame_negative.toml", kFrame},
-      {"drape/picture_frame_positive.toml", kFrame},
-      {"drape/picture_frame_unstitched.toml", kFrame},
       // Single-element verification: one element does not split.
       {"verification/damage/fibre_compression.toml", kOneElement},
       {"verification/damage/fibre_tension.toml", kOneElement},
@@ -191,6 +219,19 @@ std::vector<double> column_scales(const History& a, const History& b) {
       break;
     }
   }
+  // A column below a millionth of the largest of its unit is round-off of the others.
+  const auto unit = [](const std::string& name) -> std::string {
+    for (const char* u : {"_N_per_m", "_N", "_J", "_m", "_deg"})
+      if (name.size() > std::strlen(u) && name.ends_with(u)) return u;
+    return "";
+  };
+  std::map<std::string, double> largest;
+  for (std::size_t c = 0; c < nc; ++c)
+    if (const std::string u = unit(a.columns[c]); !u.empty())
+      largest[u] = std::max(largest[u], own[c]);
+  for (std::size_t c = 0; c < nc; ++c)
+    if (const std::string u = unit(a.columns[c]); !u.empty())
+      scale[c] = std::max(scale[c], 1e-6 * largest[u]);
   return scale;
 }
 
@@ -283,23 +324,41 @@ TEST_P(MpiRunsEveryCase, TwoRanksMatchOneRank) {
   ASSERT_EQ(h[0].rows.size(), h[1].rows.size());
   ASSERT_GT(h[0].rows.size(), 10u);
   const std::vector<double> scale = column_scales(h[0], h[1]);
-  double worst = 0;
-  std::string worst_column;
+  double worst = 0, worst_late = 0;
+  std::string worst_column, worst_late_column;
   for (std::size_t j = 0; j < h[0].columns.size(); ++j) {
-    double diff = 0;
-    std::size_t at = 0;
+    const std::string& name = h[0].columns[j];
+    const bool late =
+        std::find(c.late_columns.begin(), c.late_columns.end(), name) != c.late_columns.end();
+    double diff = 0, diff_late = 0;
+    std::size_t at = 0, at_late = 0;
     for (std::size_t r = 0; r < h[0].rows.size(); ++r) {
       const double d = std::abs(h[0].rows[r].at(j) - h[1].rows[r].at(j));
-      if (d > diff) diff = d, at = r;
+      if (h[0].rows[r][0] <= c.until) {
+        if (d > diff) diff = d, at = r;
+      } else if (d > diff_late) {
+        diff_late = d, at_late = r;
+      }
     }
     const double rel = scale[j] > 0 ? diff / scale[j] : diff;
-    EXPECT_LE(rel, c.tolerance) << c.file << ": column " << h[0].columns[j] << " differs by "
-                                << diff << " (scale " << scale[j] << ") at t = " << h[0].rows[at][0]
+    EXPECT_LE(rel, c.tolerance) << c.file << ": column " << name << " differs by " << diff
+                                << " (scale " << scale[j] << ") at t = " << h[0].rows[at][0]
                                 << " s";
-    if (rel >= worst) worst = rel, worst_column = h[0].columns[j];
+    if (rel >= worst) worst = rel, worst_column = name;
+    if (late) {
+      const double rel_late = scale[j] > 0 ? diff_late / scale[j] : diff_late;
+      EXPECT_LE(rel_late, c.late_tolerance)
+          << c.file << ": column " << name << " differs by " << diff_late << " (scale " << scale[j]
+          << ") at t = " << h[0].rows[at_late][0] << " s";
+      if (rel_late >= worst_late) worst_late = rel_late, worst_late_column = name;
+    }
   }
   std::cout << c.file << ": largest difference " << worst << " of its scale (" << worst_column
-            << "), tolerance " << c.tolerance << "\n";
+            << "), tolerance " << c.tolerance;
+  if (c.until < 1e300)
+    std::cout << " up to " << c.until << " s; after it " << worst_late << " (" << worst_late_column
+              << "), tolerance " << c.late_tolerance;
+  std::cout << "\n";
   RecordProperty("largest_difference", std::to_string(worst) + " " + worst_column);
 }
 
