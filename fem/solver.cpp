@@ -809,8 +809,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
       t0 = Clock::now();
       reduce_step(domain_->comm(), dt_new, st);
       step_ = st;
-      domain_->add_ghosts_to_owners(fi);
-      if (has_contact) domain_->add_ghosts_to_owners(Fc.data());
+      domain_->add_ghosts_to_owners(fi, has_contact ? Fc.data() : nullptr);
       timers_.exchange += seconds_since(t0);
       t0 = Clock::now();
     }
@@ -1056,8 +1055,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
     t0 = Clock::now();
     auto X = x.view();
     auto Vv = v.view();
-    domain_->refresh_ghosts(X.data());
-    domain_->refresh_ghosts(Vv.data());
+    domain_->refresh_ghosts(X.data(), Vv.data());
     timers_.exchange += seconds_since(t0);
   }
   for (auto& tool : model_.tools) tool.displacement += dt_new * tool.velocity;

@@ -95,6 +95,8 @@ Domain::Domain(MPI_Comm comm, std::size_t n_nodes, const double* x0,
   MPI_Comm_size(comm_, &size_);
   MPI_Type_contiguous(3, MPI_DOUBLE, &node3_);
   MPI_Type_commit(&node3_);
+  MPI_Type_contiguous(6, MPI_DOUBLE, &node6_);
+  MPI_Type_commit(&node6_);
 
   // Element runs, then node owners: the lowest rank with an element on the node. Every rank
   // computes the same split from the same model (no communication). A group's run on rank r
@@ -174,7 +176,9 @@ Domain::Domain(MPI_Comm comm, std::size_t n_nodes, const double* x0,
 Domain::~Domain() {
   if (ghost_sf_) PetscSFDestroy(&ghost_sf_);
   if (gather_sf_) PetscSFDestroy(&gather_sf_);
+  if (exchange_sf_) PetscSFDestroy(&exchange_sf_);
   if (node3_ != MPI_DATATYPE_NULL) MPI_Type_free(&node3_);
+  if (node6_ != MPI_DATATYPE_NULL) MPI_Type_free(&node6_);
 }
 
 std::pair<std::size_t, std::size_t> Domain::range(std::size_t g, int r) const {
@@ -207,14 +211,74 @@ void Domain::finalise() {
     const PetscInt* degree = nullptr;
     NCF_PETSC(PetscSFComputeDegreeBegin(ghost_sf_, &degree));
     NCF_PETSC(PetscSFComputeDegreeEnd(ghost_sf_, &degree));
-    for (PetscInt i = 0; i < n_roots; ++i) n_root_leaves += static_cast<std::size_t>(degree[i]);
+    for (PetscInt i = 0; i < n_roots; ++i) {
+      n_root_leaves += static_cast<std::size_t>(degree[i]);
+      if (degree[i] > 0) shared_.push_back(static_cast<std::int32_t>(i));
+    }
   }
   bytes_per_cycle_ = 24 * (2 * static_cast<std::size_t>(n_leaves) + 2 * n_root_leaves);
+  // The exchange on packed buffers: each ghost learns its node's place in its owner's shared_.
+  {
+    std::vector<PetscInt> place(n_nodes_, -1);
+    for (std::size_t k = 0; k < shared_.size(); ++k)
+      place[static_cast<std::size_t>(shared_[k])] = static_cast<PetscInt>(k);
+    NCF_PETSC(PetscSFBcastBegin(ghost_sf_, MPIU_INT, place.data(), place.data(), MPI_REPLACE));
+    NCF_PETSC(PetscSFBcastEnd(ghost_sf_, MPIU_INT, place.data(), place.data(), MPI_REPLACE));
+    std::vector<PetscSFNode> iremote(ghosts_.size());
+    for (std::size_t k = 0; k < ghosts_.size(); ++k) {
+      const auto node = static_cast<std::size_t>(ghosts_[k]);
+      iremote[k].rank = owner_[node];
+      iremote[k].index = place[node];
+    }
+    NCF_PETSC(PetscSFCreate(comm_, &exchange_sf_));
+    NCF_PETSC(PetscSFSetGraph(exchange_sf_, static_cast<PetscInt>(shared_.size()),
+                              static_cast<PetscInt>(ghosts_.size()), nullptr, PETSC_COPY_VALUES,
+                              iremote.data(), PETSC_COPY_VALUES));
+    NCF_PETSC(PetscSFSetUp(exchange_sf_));
+  }
+  leaf_buf_.assign(6 * ghosts_.size(), 0.0);
+  root_buf_.assign(6 * shared_.size(), 0.0);
 }
 
-void Domain::add_ghosts_to_owners(double* a) const {
-  NCF_PETSC(PetscSFReduceBegin(ghost_sf_, node3_, a, a, MPI_SUM));
-  NCF_PETSC(PetscSFReduceEnd(ghost_sf_, node3_, a, a, MPI_SUM));
+namespace {
+// Packs the 3 components of a and b (b may be null: a alone, 3 a node) of `nodes` into buf.
+void pack(const std::vector<std::int32_t>& nodes, const double* a, const double* b, double* buf) {
+  const std::size_t w = b ? 6 : 3;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const std::size_t i = 3 * static_cast<std::size_t>(nodes[k]);
+    double* p = buf + w * k;
+    p[0] = a[i], p[1] = a[i + 1], p[2] = a[i + 2];
+    if (b) p[3] = b[i], p[4] = b[i + 1], p[5] = b[i + 2];
+  }
+}
+void unpack(const std::vector<std::int32_t>& nodes, const double* buf, double* a, double* b) {
+  const std::size_t w = b ? 6 : 3;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const std::size_t i = 3 * static_cast<std::size_t>(nodes[k]);
+    const double* p = buf + w * k;
+    a[i] = p[0], a[i + 1] = p[1], a[i + 2] = p[2];
+    if (b) b[i] = p[3], b[i + 1] = p[4], b[i + 2] = p[5];
+  }
+}
+}  // namespace
+
+void Domain::add_ghosts_to_owners(double* f_int, double* f_contact) const {
+  // The owners' own sums go in first: each root is then its value plus its ghosts' (MPI_SUM), as
+  // a reduce in place on the whole arrays would give.
+  const MPI_Datatype unit = f_contact ? node6_ : node3_;
+  pack(ghosts_, f_int, f_contact, leaf_buf_.data());
+  pack(shared_, f_int, f_contact, root_buf_.data());
+  NCF_PETSC(PetscSFReduceBegin(exchange_sf_, unit, leaf_buf_.data(), root_buf_.data(), MPI_SUM));
+  NCF_PETSC(PetscSFReduceEnd(exchange_sf_, unit, leaf_buf_.data(), root_buf_.data(), MPI_SUM));
+  unpack(shared_, root_buf_.data(), f_int, f_contact);
+}
+
+void Domain::refresh_ghosts(double* x, double* v) const {
+  pack(shared_, x, v, root_buf_.data());
+  NCF_PETSC(
+      PetscSFBcastBegin(exchange_sf_, node6_, root_buf_.data(), leaf_buf_.data(), MPI_REPLACE));
+  NCF_PETSC(PetscSFBcastEnd(exchange_sf_, node6_, root_buf_.data(), leaf_buf_.data(), MPI_REPLACE));
+  unpack(ghosts_, leaf_buf_.data(), x, v);
 }
 
 void Domain::refresh_ghosts(double* a) const {

@@ -11,9 +11,10 @@
 //    no element); a rank updates its owned nodes only;
 //  - ghosts: the nodes a rank reads but does not own (the other corners of its elements, and what
 //    its contacts read: remote segments within the contact halo, tie masters, joint hexahedra).
-// Each cycle the forces at ghosts are added into their owners (one PetscSF reduce per force
-// array) and the owners' new positions and velocities are copied back to the ghosts (one PetscSF
-// broadcast each): the only nodal traffic, proportional to the partition surface.
+// Each cycle the forces at ghosts are added into their owners (one PetscSF reduce of the internal
+// and contact forces, packed 6 doubles a node) and the owners' new positions and velocities are
+// copied back to the ghosts (one PetscSF broadcast of x and v, 6 doubles a node): the only nodal
+// traffic, proportional to the partition surface, in one message each way per neighbour.
 #include <mpi.h>
 #include <petscsf.h>
 
@@ -61,10 +62,14 @@ class Domain {
   void finalise();
   std::size_t n_ghosts() const { return ghosts_.size(); }
 
-  /// Adds the ghost entries of a nodal array [3*n_nodes] into their owners' (collective). The
-  /// ghost entries are left as they were.
-  void add_ghosts_to_owners(double* a) const;
-  /// Copies the owners' entries of a nodal array to this rank's ghosts (collective).
+  /// Adds the ghost entries of the nodal force arrays [3*n_nodes] f_int and f_contact (null: no
+  /// contact forces, f_int alone) into their owners' (collective; one reduce, the two packed per
+  /// node). The ghost entries are left as they were.
+  void add_ghosts_to_owners(double* f_int, double* f_contact) const;
+  /// Copies the owners' positions and velocities [3*n_nodes] to this rank's ghosts (collective;
+  /// one broadcast, x and v packed per node).
+  void refresh_ghosts(double* x, double* v) const;
+  /// Copies the owners' entries of one nodal array to this rank's ghosts (collective).
   void refresh_ghosts(double* a) const;
   /// Copies every node's entries from its owner into the root's array (collective; the root's
   /// array then holds the whole field; other ranks' arrays are not changed).
@@ -72,7 +77,8 @@ class Domain {
   /// Gathers each rank's run of group g's state array [components][n] into the root's.
   void gather_group_array(std::size_t g, double* data, std::size_t n, int components) const;
 
-  /// Bytes this rank sends per cycle in the ghost exchange (two force arrays, x and v).
+  /// Bytes this rank sends per cycle in the ghost exchange (internal and contact forces, x and v:
+  /// 48 bytes a ghost node each way).
   std::size_t ghost_bytes_per_cycle() const { return bytes_per_cycle_; }
 
  private:
@@ -85,9 +91,13 @@ class Domain {
   std::vector<std::uint8_t> owned_, readable_;
   std::vector<std::pair<std::size_t, std::size_t>> runs_;
   std::vector<std::int32_t> ghosts_;
+  std::vector<std::int32_t> shared_;  // owned nodes that other ranks read (ascending)
   PetscSF ghost_sf_ = nullptr;   // leaves: this rank's ghosts; roots: the owners' entries
   PetscSF gather_sf_ = nullptr;  // leaves (root only): nodes the root does not own
-  MPI_Datatype node3_ = MPI_DATATYPE_NULL;
+  // The per-cycle exchange on packed buffers: leaf k is ghosts_[k], root k is shared_[k].
+  PetscSF exchange_sf_ = nullptr;
+  mutable std::vector<double> leaf_buf_, root_buf_;  // [6 * ghosts], [6 * shared]
+  MPI_Datatype node3_ = MPI_DATATYPE_NULL, node6_ = MPI_DATATYPE_NULL;
 };
 
 }  // namespace ncfsim::fem
