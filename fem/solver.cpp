@@ -714,334 +714,381 @@ void ExplicitSolver::share_blow_up(const std::string& what) const {
   throw NumericalError(msg);
 }
 
+// One cycle of central differences: the phases below in order, each reading what the ones before
+// left in `c`. The vectors' views are held over them and released before the callback, which may
+// read the vectors itself.
 void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x) {
-  const std::size_t n = model_.mesh.n_nodes(), nd = 3 * n;
-  const bool move_x_in_pass = !at_tn || !at_tn_reads_x;
-  auto t0 = Clock::now();
-  double dt_new = 0;
-  {  // views are released before the callback, which may read the vectors itself
+  Cycle c;
+  c.move_x_in_pass = !at_tn || !at_tn_reads_x;
+  {
     auto X = x.view();
     auto Vv = v.view();
+    auto X0 = x0.view();
     auto M = mass.view();
     auto Fi = f_int.view();
     auto Fe = f_ext.view();
     auto Fc = f_contact.view();
     auto Fd = f_damp.view();
     auto Rr = reaction.view();
-    double* fi = Fi.data();
-    // Arrays a model does not use stay zero and are neither cleared nor read in the node loop.
-    const bool has_ext = !model_.loads.empty() || model_.gravity.x != 0 || model_.gravity.y != 0 ||
-                         model_.gravity.z != 0;
-    const bool has_contact =
-        !model_.tools.empty() || !model_.contacts.empty() || has_motion_forces_;
-    const bool has_damp = model_.mass_damping != 0 &&
-                          (model_.mass_damping_end_time <= 0 || t_ < model_.mass_damping_end_time);
-    std::fill(fi, fi + nd, 0.0);
-    if (has_ext) std::fill(Fe.data(), Fe.data() + nd, 0.0);
-    if (has_contact) std::fill(Fc.data(), Fc.data() + nd, 0.0);
-
-    // Several ranks: energies booked directly in the cycle (erosion) are summed over the ranks
-    // as increments from here.
-    const std::array<double, 3> booked0 = {energy_.internal, energy_.eroded_internal,
-                                           energy_.eroded_kinetic};
-    eroded_any_ = false;
-    // Internal forces at x^n from v^{n-1/2}.
-    ElementEnergyIncrement inc;
-    StableStep st;
-    {
-      auto X0 = x0.view();
-      const ElementCycleState cs{X.data(), Vv.data(), X0.data(), dt_prev_};
-      std::string blow_up;  // several ranks: a kernel's blow-up report, shared below
-      for (std::size_t k = 0; k < groups_.size() && blow_up.empty(); ++k) {
-        group_step_[k] = StableStep{};
-        try {
-          groups_[k]->internal_forces(cs, fi, inc, group_step_[k]);
-        } catch (const NumericalError& e) {
-          if (!domain_) throw;
-          blow_up = e.what();
-        }
-      }
-      if (domain_) share_blow_up(blow_up);
-    }
-    // Erosion: a step below the limit is seen at once; folded corners, which develop over many
-    // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
-    // A failed material point (damage laws) is eroded in the cycle it fails.
-    const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
-    if (dt_erode > 0 || material_failure_) {
-      bool check_steps = false;
-      if (dt_erode > 0) {
-        StableStep erodible;
-        for (std::size_t k = 0; k < groups_.size(); ++k)
-          if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
-        check_steps =
-            model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0;
-      }
-      erode(X.data(), Vv.data(), dt_erode, check_steps);
-    }
-    for (const auto& s : group_step_) take_smaller(st, s);
-    if (!domain_) {  // on several ranks they are summed over the ranks with the works below
-      energy_.internal += inc.internal;
-      energy_.stabilisation += inc.stabilisation;
-      energy_.hourglass += inc.hourglass;
-      energy_.rotational_kinetic += inc.kinetic;
-    }
-    step_ = st;
-    dt_new = model_.time.safety_factor * st.dt;
-    if (dt_prev_ > 0) dt_new = std::min(dt_new, 1.1 * dt_prev_);  // limit step growth
-    if (st.element < 0 && dt_prev_ > 0) dt_new = dt_prev_;        // every element eroded: no bound
+    const CycleArrays a{X.data(),  Vv.data(), X0.data(), M.data(), Fi.data(),
+                        Fe.data(), Fc.data(), Fd.data(), Rr.data()};
+    auto t0 = Clock::now();
+    internal_forces(a, c);
+    erode_and_choose_step(a, c);
     timers_.internal_force += seconds_since(t0);
-
-    // Contact with rigid tools at x^n.
     t0 = Clock::now();
-    const double dt_c = dt_prev_ > 0 ? dt_prev_ : dt_new;
-    for (auto& tool : model_.tools)
-      tool_contact_forces(tool, X.data(), Vv.data(), M.data(), dt_c, Fc.data());
-    for (auto& c : model_.contacts) {
-      c->add_forces(X.data(), Vv.data(), M.data(), dt_c, Fc.data());
-      dt_new = std::min(dt_new, c->stable_step_limit());
-    }
-    for (auto& m : motions_)
-      if (m->has_forces()) m->add_forces(t_, X.data(), M.data(), dt_c, Fc.data());
+    contact_forces(a, c);
     timers_.contact += seconds_since(t0);
     if (domain_) {
-      // The smallest step of all ranks (its element named as on one rank) and every node's
-      // whole force on its owner.
       t0 = Clock::now();
-      reduce_step(domain_->comm(), dt_new, st);
-      step_ = st;
-      domain_->add_ghosts_to_owners(fi, has_contact ? Fc.data() : nullptr);
+      exchange_forces(a, c);
       timers_.exchange += seconds_since(t0);
-      t0 = Clock::now();
     }
-
-    // External forces at t^n, damping from v^{n-1/2}.
     t0 = Clock::now();
-    for (const auto& ld : model_.loads) {
-      const V3 F = smooth_ramp(t_, ld.ramp_time) * ld.force_per_node;
-      for (auto node : ld.nodes) {
-        const auto i = static_cast<std::size_t>(node);
-        Fe[3 * i] += F.x, Fe[3 * i + 1] += F.y, Fe[3 * i + 2] += F.z;
-      }
-    }
-    const V3 g = smooth_ramp(t_, model_.gravity_ramp_time) * model_.gravity;
-    if (g.x != 0 || g.y != 0 || g.z != 0)
-      for (std::size_t i = 0; i < n; ++i)
-        Fe[3 * i] += gravity_mass_[3 * i] * g.x, Fe[3 * i + 1] += gravity_mass_[3 * i + 1] * g.y,
-            Fe[3 * i + 2] += gravity_mass_[3 * i + 2] * g.z;
-    const double alpha = has_damp ? model_.mass_damping : 0.0;
-
-    if (dt_new < model_.time.min_step_ratio * dt_initial_) {
-      std::ostringstream os;
-      os << "numerical instability: the stable time step fell to " << dt_new << " s ("
-         << dt_new / dt_initial_ << " of the initial " << dt_initial_ << " s) at t = " << t_
-         << " s, cycle " << cycle_ << "; controlled by " << element_noun(st.kind) << " "
-         << st.element << " at " << element_position(st, X.data())
-         << " (severely distorted or inverted)";
-      throw NumericalError(os.str());
-    }
-
-    // Prescribed velocities at t^{n+1/2}.
-    const double t_half = t_ + 0.5 * dt_new;
-    std::vector<V3>& vpres = vpres_;
-    for (std::size_t k = 0; k < vpres.size(); ++k)
-      vpres[k] =
-          smooth_ramp(t_half - model_.velocities[k].start_time, model_.velocities[k].ramp_time) *
-          model_.velocities[k].velocity;
-
-    // v^{n+1/2}; works of each force kind over the increments around t^n.
-    const double dt_mid = 0.5 * (dt_prev_ + dt_new);
-    // Unless the callback reads x^n the position update joins this loop (one pass over the
-    // nodal arrays).
-    double* xfused = move_x_in_pass ? X.data() : nullptr;
-    const double* inv_m = inv_mass_.data();
-    const double* fe = has_ext ? Fe.data() : zero_.data();
-    const double* fcon = has_contact ? Fc.data() : zero_.data();
-    double* fdamp = Fd.data();
-    double* rr = Rr.data();
-    double* vel = Vv.data();
-    const double* mm = M.data();
-    // Constrained DOFs keep their v^{n-1/2} aside: the free update below runs over every DOF
-    // without branches (it vectorises), then those DOFs are corrected.
-    // With the positions moved in the pass their x^n too, so that a held DOF ends at
-    // x^n + dt v^{n+1/2} exactly as in a separate position pass.
-    for (std::size_t k = 0; k < constrained_.size(); ++k) constrained_vo_[k] = vel[constrained_[k]];
-    freeing_vo_.resize(freeing_.size());
-    for (std::size_t k = 0; k < freeing_.size(); ++k) freeing_vo_[k] = vel[freeing_[k]];
-    if (xfused) {
-      constrained_xo_.resize(constrained_.size());
-      for (std::size_t k = 0; k < constrained_.size(); ++k)
-        constrained_xo_[k] = xfused[constrained_[k]];
-      freeing_xo_.resize(freeing_.size());
-      for (std::size_t k = 0; k < freeing_.size(); ++k) freeing_xo_[k] = xfused[freeing_[k]];
-    }
-    const double dtp = dt_prev_;
-    // Without damping this cycle f_damp is left alone by the pass, so it is cleared once here.
-    if (alpha == 0 && !f_damp_zero_) std::fill(fdamp, fdamp + nd, 0.0);
-    f_damp_zero_ = alpha == 0;
-    const std::size_t kind =
-        (xfused ? 8 : 0) + (has_ext ? 4 : 0) + (has_contact ? 2 : 0) + (alpha != 0 ? 1 : 0);
-    auto [ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke] =
-        domain_ ? owned_node_update(kNodeUpdates[kind], domain_->owned_runs(), alpha, dt_mid,
-                                    dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp, xfused)
-                : kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, fi, fe, fcon, vel, fdamp,
-                                     xfused);
-    // Works over the increments du_old = dt_prev v^{n-1/2}, du_new = dt_new v^{n+1/2}; kinetic
-    // energy in product form: with the trapezoidal works, 1/2 v^{n-1/2} M v^{n+1/2} makes the
-    // discrete energy balance of central differences exact for conservative forces.
-    ext_old *= dtp, ext_new *= dt_new, damp_old *= dtp, damp_new *= dt_new, con_old *= dtp,
-        con_new *= dt_new;
-    ke *= 0.5;
-    const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
-    for (auto& m : motions_) m->velocities(t_half, motion_v_.data());
-    // Holds DOF d (v^{n-1/2} = vo, free v^{n+1/2} in vel) at velocity vp: the works of the forces
-    // over the new increment and the kinetic energy are corrected; returns the reaction.
-    const auto hold = [&](std::size_t d, double vo, double vp, double xo) {
-      const double m = mm[d], vfree = vel[d], dv = vp - vfree;
-      vel[d] = vp;
-      if (xfused) xfused[d] = xo + dt_new * vp;
-      ext_new += fe[d] * dt_new * dv;
-      damp_new += fdamp[d] * dt_new * dv;
-      con_new += fcon[d] * dt_new * dv;
-      ke += 0.5 * m * vo * dv;
-      return m * dv * inv_dt_mid;
-    };
-    for (std::size_t k = 0; k < constrained_.size(); ++k) {
-      const std::size_t d = constrained_[k];
-      const std::uint8_t code = fixed_mask_[d];
-      const double vo = constrained_vo_[k];
-      double vp = 0.0;
-      if (code == 254) {
-        vp = motion_v_[k];
-      } else if (code > 1) {
-        vp = vpres[code - 2].arr()[d % 3];
-      }
-      const double r = hold(d, vo, vp, xfused ? constrained_xo_[k] : 0.0);
-      rr[d] = r;
-      ext_old += r * dtp * vo;
-      ext_new += r * dt_new * vp;
-    }
-    // Nodes freed by erosion this cycle (free_orphan_nodes) are held at rest like a fixed DOF;
-    // the work of that reaction, 1/2 r du_old as the external work would book it, is their
-    // kinetic energy (product form), which leaves the model. Then a zero inverse mass keeps them.
-    for (std::size_t k = 0; k < freeing_.size(); ++k) {
-      const std::size_t d = freeing_[k];
-      const double vo = freeing_vo_[k];
-      energy_.eroded_kinetic -= 0.5 * hold(d, vo, 0.0, xfused ? freeing_xo_[k] : 0.0) * dtp * vo;
-      inv_mass_[d] = 0;
-    }
-    freeing_.clear();
-    // An eroded element's nodes may be owned elsewhere: their v^{n+1/2} first.
-    if (domain_ && eroded_any_) domain_->refresh_ghosts(vel);
-    for (const auto& ef : eroded_forces_)  // see ErodedForce
-      for (int I = 0; I < ef.n_nodes; ++I)
-        for (int c = 0; c < 3; ++c)
-          energy_.internal +=
-              0.5 * ef.f[3 * I + c] * dt_new * vel[3 * static_cast<std::size_t>(ef.node[I]) + c];
-    eroded_forces_.clear();
-    if (domain_) {
-      // Works, kinetic energy, element energy increments, tool forces and friction: each rank
-      // holds its nodes' and elements' share.
-      const auto tr = Clock::now();
-      std::vector<double>& r = reduce_buffer_;
-      r.assign({ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke, inc.internal,
-                inc.stabilisation, inc.hourglass, inc.kinetic, energy_.internal - booked0[0],
-                energy_.eroded_internal - booked0[1], energy_.eroded_kinetic - booked0[2]});
-      double fr_rank = 0;  // friction dissipated so far, this rank's share
-      for (const auto& tool : model_.tools) fr_rank += tool.friction_dissipation;
-      for (const auto& c : model_.contacts) fr_rank += c->friction_dissipation();
-      r.push_back(fr_rank);
-      for (const auto& tool : model_.tools)
-        r.insert(r.end(), {tool.force.x, tool.force.y, tool.force.z});
-      // The rigs' walls push this rank's nodes: their work (rig and on the nodes) is its share.
-      std::array<double, 4> mw = {0, 0, 0, 0};
-      for (auto& m : motions_)
-        if (m->has_forces())
-          m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, mw[0], mw[1], mw[2],
-                            mw[3]);
-      if (has_motion_forces_) r.insert(r.end(), mw.begin(), mw.end());
-      MPI_Allreduce(MPI_IN_PLACE, r.data(), static_cast<int>(r.size()), MPI_DOUBLE, MPI_SUM,
-                    domain_->comm());
-      ext_old = r[0], ext_new = r[1], damp_old = r[2], damp_new = r[3], con_old = r[4],
-      con_new = r[5], ke = r[6];
-      energy_.internal = booked0[0] + r[11] + r[7];
-      energy_.eroded_internal = booked0[1] + r[12];
-      energy_.eroded_kinetic = booked0[2] + r[13];
-      energy_.stabilisation += r[8];
-      energy_.hourglass += r[9];
-      energy_.rotational_kinetic += r[10];
-      friction_all_ranks_ = r[14];
-      for (std::size_t k = 0; k < model_.tools.size(); ++k)
-        model_.tools[k].force = {r[15 + 3 * k], r[16 + 3 * k], r[17 + 3 * k]};
-      if (has_motion_forces_) std::copy(r.end() - 4, r.end(), motion_work_all_ranks_.begin());
-      timers_.exchange += seconds_since(tr);
-    }
-    w_ext_.add(ext_old, ext_new);
-    w_damp_.add(damp_old, damp_new);
-    w_contact_nodes_.add(con_old, con_new);
-
-    // Tools: velocity over the next half step, and their work.
-    double tool_on_nodes_old = 0, tool_on_nodes_new = 0, tool_src_old = 0, tool_src_new = 0;
-    for (auto& tool : model_.tools) {
-      const V3 vo = tool.velocity;
-      V3 vn;
-      if (tool.motion.kind == ToolMotion::Kind::Velocity) {
-        vn = tool_prescribed_velocity(tool, t_half);
-      } else if (tool.motion.kind == ToolMotion::Kind::Force) {
-        const V3 ax = tool.motion.axis;
-        const double a = (tool.motion.force + dot(tool.force, ax)) / tool.motion.mass;
-        vn = (dot(vo, ax) + dt_mid * a) * ax;
-        ke += 0.5 * tool.motion.mass * dot(vo, vn);
-      }
-      tool.velocity = vn;
-      // The tool pushes the nodes with -tool.force.
-      tool_on_nodes_old += -dot(tool.force, dt_prev_ * vo);
-      tool_on_nodes_new += -dot(tool.force, dt_new * vn);
-      if (tool.motion.kind == ToolMotion::Kind::Velocity) {
-        tool_src_old += -dot(tool.force, dt_prev_ * vo);
-        tool_src_new += -dot(tool.force, dt_new * vn);
-      } else if (tool.motion.kind == ToolMotion::Kind::Force) {
-        const V3 F = tool.motion.force * tool.motion.axis;
-        tool_src_old += dot(F, dt_prev_ * vo);
-        tool_src_new += dot(F, dt_new * vn);
-      }
-    }
-    // Rigs' walls: driven like velocity tools, so their work on the nodes is the rig's (external)
-    // work; the contact energy keeps the penalty energy stored.
-    if (!domain_) {
-      for (auto& m : motions_)
-        if (m->has_forces())
-          m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, tool_src_old,
-                            tool_src_new, tool_on_nodes_old, tool_on_nodes_new);
-    } else if (has_motion_forces_) {  // summed over the ranks above
-      const auto& mw = motion_work_all_ranks_;
-      tool_src_old += mw[0], tool_src_new += mw[1];
-      tool_on_nodes_old += mw[2], tool_on_nodes_new += mw[3];
-    }
-    w_tools_.add(tool_src_old, tool_src_new);
-    tool_work_on_nodes_.add(tool_on_nodes_old, tool_on_nodes_new);
-
-    energy_.time = t_;
-    energy_.kinetic = ke + energy_.rotational_kinetic;
-    energy_.external_work = w_ext_.committed + w_tools_.committed;
-    energy_.damping = -w_damp_.committed;
-    energy_.contact = tool_work_on_nodes_.committed - w_contact_nodes_.committed;
-    double fr = 0;
-    for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
-    for (const auto& c : model_.contacts) fr += c->friction_dissipation();
-    energy_.friction = domain_ ? friction_all_ranks_ : fr;
-    energy_.scale_max = std::max(energy_.scale_max, energy_.scale());
-    if (!std::isfinite(ke)) check_finite(Vv.data());
+    external_forces(a, c);
+    update_velocities(a, c);
+    if (domain_) sum_over_ranks(c);
+    book_energies(a, c);
     timers_.update += seconds_since(t0);
   }
-
   if (at_tn) {
-    t0 = Clock::now();
+    const auto t0 = Clock::now();
     at_tn();
     timers_.output += seconds_since(t0);
   }
+  finish_cycle(c);
+}
 
-  // x^{n+1} (already done in the velocity loop unless the callback reads x^n)
-  if (!move_x_in_pass) {
+// Clears the force arrays and adds the elements' internal forces at x^n from v^{n-1/2}.
+void ExplicitSolver::internal_forces(const CycleArrays& a, Cycle& c) {
+  const std::size_t nd = 3 * model_.mesh.n_nodes();
+  // Arrays a model does not use stay zero and are neither cleared nor read in the node loop.
+  c.has_ext = !model_.loads.empty() || model_.gravity.x != 0 || model_.gravity.y != 0 ||
+              model_.gravity.z != 0;
+  c.has_contact = !model_.tools.empty() || !model_.contacts.empty() || has_motion_forces_;
+  c.has_damp = model_.mass_damping != 0 &&
+               (model_.mass_damping_end_time <= 0 || t_ < model_.mass_damping_end_time);
+  std::fill(a.fi, a.fi + nd, 0.0);
+  if (c.has_ext) std::fill(a.fe, a.fe + nd, 0.0);
+  if (c.has_contact) std::fill(a.fc, a.fc + nd, 0.0);
+
+  // Several ranks: energies booked directly in the cycle (erosion) are summed over the ranks
+  // as increments from here.
+  c.booked0 = {energy_.internal, energy_.eroded_internal, energy_.eroded_kinetic};
+  eroded_any_ = false;
+  const ElementCycleState cs{a.x, a.v, a.x0, dt_prev_};
+  std::string blow_up;  // several ranks: a kernel's blow-up report, shared below
+  for (std::size_t k = 0; k < groups_.size() && blow_up.empty(); ++k) {
+    group_step_[k] = StableStep{};
+    try {
+      groups_[k]->internal_forces(cs, a.fi, c.inc, group_step_[k]);
+    } catch (const NumericalError& e) {
+      if (!domain_) throw;
+      blow_up = e.what();
+    }
+  }
+  if (domain_) share_blow_up(blow_up);
+}
+
+// Erosion, then the next step from the elements left (this rank's; exchange_forces takes the
+// smallest over the ranks).
+void ExplicitSolver::erode_and_choose_step(const CycleArrays& a, Cycle& c) {
+  // Erosion: a step below the limit is seen at once; folded corners, which develop over many
+  // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
+  // A failed material point (damage laws) is eroded in the cycle it fails.
+  const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
+  if (dt_erode > 0 || material_failure_) {
+    bool check_steps = false;
+    if (dt_erode > 0) {
+      StableStep erodible;
+      for (std::size_t k = 0; k < groups_.size(); ++k)
+        if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
+      check_steps =
+          model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0;
+    }
+    erode(a.x, a.v, dt_erode, check_steps);
+  }
+  for (const auto& s : group_step_) take_smaller(c.st, s);
+  if (!domain_) {  // on several ranks they are summed over the ranks with the works
+    energy_.internal += c.inc.internal;
+    energy_.stabilisation += c.inc.stabilisation;
+    energy_.hourglass += c.inc.hourglass;
+    energy_.rotational_kinetic += c.inc.kinetic;
+  }
+  step_ = c.st;
+  c.dt_new = model_.time.safety_factor * c.st.dt;
+  if (dt_prev_ > 0) c.dt_new = std::min(c.dt_new, 1.1 * dt_prev_);  // limit step growth
+  if (c.st.element < 0 && dt_prev_ > 0) c.dt_new = dt_prev_;  // every element eroded: no bound
+}
+
+// Contact forces at x^n: rigid tools, contacts (which may lower the step), rigs' walls.
+void ExplicitSolver::contact_forces(const CycleArrays& a, Cycle& c) {
+  const double dt_c = dt_prev_ > 0 ? dt_prev_ : c.dt_new;
+  for (auto& tool : model_.tools) tool_contact_forces(tool, a.x, a.v, a.m, dt_c, a.fc);
+  for (auto& k : model_.contacts) {
+    k->add_forces(a.x, a.v, a.m, dt_c, a.fc);
+    c.dt_new = std::min(c.dt_new, k->stable_step_limit());
+  }
+  for (auto& m : motions_)
+    if (m->has_forces()) m->add_forces(t_, a.x, a.m, dt_c, a.fc);
+}
+
+// Several ranks: the smallest step of all ranks (its element named as on one rank) and every
+// node's whole force on its owner.
+void ExplicitSolver::exchange_forces(const CycleArrays& a, Cycle& c) {
+  reduce_step(domain_->comm(), c.dt_new, c.st);
+  step_ = c.st;
+  domain_->add_ghosts_to_owners(a.fi, c.has_contact ? a.fc : nullptr);
+}
+
+// External forces at t^n (loads, gravity); a step below time.min_step_ratio stops the run.
+void ExplicitSolver::external_forces(const CycleArrays& a, Cycle& c) {
+  const std::size_t n = model_.mesh.n_nodes();
+  for (const auto& ld : model_.loads) {
+    const V3 F = smooth_ramp(t_, ld.ramp_time) * ld.force_per_node;
+    for (auto node : ld.nodes) {
+      const auto i = static_cast<std::size_t>(node);
+      a.fe[3 * i] += F.x, a.fe[3 * i + 1] += F.y, a.fe[3 * i + 2] += F.z;
+    }
+  }
+  const V3 g = smooth_ramp(t_, model_.gravity_ramp_time) * model_.gravity;
+  if (g.x != 0 || g.y != 0 || g.z != 0)
+    for (std::size_t i = 0; i < n; ++i)
+      a.fe[3 * i] += gravity_mass_[3 * i] * g.x, a.fe[3 * i + 1] += gravity_mass_[3 * i + 1] * g.y,
+          a.fe[3 * i + 2] += gravity_mass_[3 * i + 2] * g.z;
+  c.alpha = c.has_damp ? model_.mass_damping : 0.0;  // damping from v^{n-1/2}
+
+  const double dt_new = c.dt_new;
+  if (dt_new < model_.time.min_step_ratio * dt_initial_) {
+    std::ostringstream os;
+    os << "numerical instability: the stable time step fell to " << dt_new << " s ("
+       << dt_new / dt_initial_ << " of the initial " << dt_initial_ << " s) at t = " << t_
+       << " s, cycle " << cycle_ << "; controlled by " << element_noun(c.st.kind) << " "
+       << c.st.element << " at " << element_position(c.st, a.x)
+       << " (severely distorted or inverted)";
+    throw NumericalError(os.str());
+  }
+}
+
+// v^{n+1/2} of every DOF (x^{n+1} too when the callback does not read x^n), constrained and
+// freed DOFs held at their velocities; the works of each force kind over the increments around
+// t^n and the kinetic energy into c (this rank's share).
+void ExplicitSolver::update_velocities(const CycleArrays& a, Cycle& c) {
+  const std::size_t nd = 3 * model_.mesh.n_nodes();
+  const double dt_new = c.dt_new, alpha = c.alpha;
+  // Prescribed velocities at t^{n+1/2}.
+  c.t_half = t_ + 0.5 * dt_new;
+  std::vector<V3>& vpres = vpres_;
+  for (std::size_t k = 0; k < vpres.size(); ++k)
+    vpres[k] =
+        smooth_ramp(c.t_half - model_.velocities[k].start_time, model_.velocities[k].ramp_time) *
+        model_.velocities[k].velocity;
+
+  const double dt_mid = c.dt_mid = 0.5 * (dt_prev_ + dt_new);
+  // Unless the callback reads x^n the position update joins this loop (one pass over the
+  // nodal arrays).
+  double* xfused = c.move_x_in_pass ? a.x : nullptr;
+  const double* inv_m = inv_mass_.data();
+  const double* fe = c.has_ext ? a.fe : zero_.data();
+  const double* fcon = c.has_contact ? a.fc : zero_.data();
+  double* fdamp = a.fd;
+  double* rr = a.r;
+  double* vel = a.v;
+  const double* mm = a.m;
+  // Constrained DOFs keep their v^{n-1/2} aside: the free update below runs over every DOF
+  // without branches (it vectorises), then those DOFs are corrected.
+  // With the positions moved in the pass their x^n too, so that a held DOF ends at
+  // x^n + dt v^{n+1/2} exactly as in a separate position pass.
+  for (std::size_t k = 0; k < constrained_.size(); ++k) constrained_vo_[k] = vel[constrained_[k]];
+  freeing_vo_.resize(freeing_.size());
+  for (std::size_t k = 0; k < freeing_.size(); ++k) freeing_vo_[k] = vel[freeing_[k]];
+  if (xfused) {
+    constrained_xo_.resize(constrained_.size());
+    for (std::size_t k = 0; k < constrained_.size(); ++k)
+      constrained_xo_[k] = xfused[constrained_[k]];
+    freeing_xo_.resize(freeing_.size());
+    for (std::size_t k = 0; k < freeing_.size(); ++k) freeing_xo_[k] = xfused[freeing_[k]];
+  }
+  const double dtp = dt_prev_;
+  // Without damping this cycle f_damp is left alone by the pass, so it is cleared once here.
+  if (alpha == 0 && !f_damp_zero_) std::fill(fdamp, fdamp + nd, 0.0);
+  f_damp_zero_ = alpha == 0;
+  const std::size_t kind =
+      (xfused ? 8 : 0) + (c.has_ext ? 4 : 0) + (c.has_contact ? 2 : 0) + (alpha != 0 ? 1 : 0);
+  const NodeUpdateSums s =
+      domain_ ? owned_node_update(kNodeUpdates[kind], domain_->owned_runs(), alpha, dt_mid, dt_new,
+                                  inv_m, mm, a.fi, fe, fcon, vel, fdamp, xfused)
+              : kNodeUpdates[kind](nd, alpha, dt_mid, dt_new, inv_m, mm, a.fi, fe, fcon, vel, fdamp,
+                                   xfused);
+  double &ext_old = c.ext_old, &ext_new = c.ext_new, &damp_old = c.damp_old, &damp_new = c.damp_new,
+         &con_old = c.con_old, &con_new = c.con_new, &ke = c.ke;
+  ext_old = s.ext_old, ext_new = s.ext_new, damp_old = s.damp_old, damp_new = s.damp_new;
+  con_old = s.con_old, con_new = s.con_new, ke = s.ke;
+  // Works over the increments du_old = dt_prev v^{n-1/2}, du_new = dt_new v^{n+1/2}; kinetic
+  // energy in product form: with the trapezoidal works, 1/2 v^{n-1/2} M v^{n+1/2} makes the
+  // discrete energy balance of central differences exact for conservative forces.
+  ext_old *= dtp, ext_new *= dt_new, damp_old *= dtp, damp_new *= dt_new, con_old *= dtp,
+      con_new *= dt_new;
+  ke *= 0.5;
+  const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
+  for (auto& m : motions_) m->velocities(c.t_half, motion_v_.data());
+  // Holds DOF d (v^{n-1/2} = vo, free v^{n+1/2} in vel) at velocity vp: the works of the forces
+  // over the new increment and the kinetic energy are corrected; returns the reaction.
+  const auto hold = [&](std::size_t d, double vo, double vp, double xo) {
+    const double m = mm[d], vfree = vel[d], dv = vp - vfree;
+    vel[d] = vp;
+    if (xfused) xfused[d] = xo + dt_new * vp;
+    ext_new += fe[d] * dt_new * dv;
+    damp_new += fdamp[d] * dt_new * dv;
+    con_new += fcon[d] * dt_new * dv;
+    ke += 0.5 * m * vo * dv;
+    return m * dv * inv_dt_mid;
+  };
+  for (std::size_t k = 0; k < constrained_.size(); ++k) {
+    const std::size_t d = constrained_[k];
+    const std::uint8_t code = fixed_mask_[d];
+    const double vo = constrained_vo_[k];
+    double vp = 0.0;
+    if (code == 254) {
+      vp = motion_v_[k];
+    } else if (code > 1) {
+      vp = vpres[code - 2].arr()[d % 3];
+    }
+    const double r = hold(d, vo, vp, xfused ? constrained_xo_[k] : 0.0);
+    rr[d] = r;
+    ext_old += r * dtp * vo;
+    ext_new += r * dt_new * vp;
+  }
+  // Nodes freed by erosion this cycle (free_orphan_nodes) are held at rest like a fixed DOF;
+  // the work of that reaction, 1/2 r du_old as the external work would book it, is their
+  // kinetic energy (product form), which leaves the model. Then a zero inverse mass keeps them.
+  for (std::size_t k = 0; k < freeing_.size(); ++k) {
+    const std::size_t d = freeing_[k];
+    const double vo = freeing_vo_[k];
+    energy_.eroded_kinetic -= 0.5 * hold(d, vo, 0.0, xfused ? freeing_xo_[k] : 0.0) * dtp * vo;
+    inv_mass_[d] = 0;
+  }
+  freeing_.clear();
+  // An eroded element's nodes may be owned elsewhere: their v^{n+1/2} first.
+  if (domain_ && eroded_any_) domain_->refresh_ghosts(vel);
+  for (const auto& ef : eroded_forces_)  // see ErodedForce
+    for (int I = 0; I < ef.n_nodes; ++I)
+      for (int k = 0; k < 3; ++k)
+        energy_.internal +=
+            0.5 * ef.f[3 * I + k] * dt_new * vel[3 * static_cast<std::size_t>(ef.node[I]) + k];
+  eroded_forces_.clear();
+}
+
+// Several ranks: works, kinetic energy, element energy increments, energies booked by erosion,
+// friction, tool forces and the rigs' wall works, each rank holding its nodes' and elements'
+// share, summed over the ranks (one reduction).
+void ExplicitSolver::sum_over_ranks(Cycle& c) {
+  const auto tr = Clock::now();
+  const auto& booked0 = c.booked0;
+  const auto& inc = c.inc;
+  std::vector<double>& r = reduce_buffer_;
+  r.assign({c.ext_old, c.ext_new, c.damp_old, c.damp_new, c.con_old, c.con_new, c.ke, inc.internal,
+            inc.stabilisation, inc.hourglass, inc.kinetic, energy_.internal - booked0[0],
+            energy_.eroded_internal - booked0[1], energy_.eroded_kinetic - booked0[2]});
+  double fr_rank = 0;  // friction dissipated so far, this rank's share
+  for (const auto& tool : model_.tools) fr_rank += tool.friction_dissipation;
+  for (const auto& k : model_.contacts) fr_rank += k->friction_dissipation();
+  r.push_back(fr_rank);
+  for (const auto& tool : model_.tools)
+    r.insert(r.end(), {tool.force.x, tool.force.y, tool.force.z});
+  // The rigs' walls push this rank's nodes: their work (rig and on the nodes) is its share.
+  std::array<double, 4> mw = {0, 0, 0, 0};
+  for (auto& m : motions_)
+    if (m->has_forces())
+      m->add_force_work(t_ - 0.5 * dt_prev_, c.t_half, dt_prev_, c.dt_new, mw[0], mw[1], mw[2],
+                        mw[3]);
+  if (has_motion_forces_) r.insert(r.end(), mw.begin(), mw.end());
+  MPI_Allreduce(MPI_IN_PLACE, r.data(), static_cast<int>(r.size()), MPI_DOUBLE, MPI_SUM,
+                domain_->comm());
+  c.ext_old = r[0], c.ext_new = r[1], c.damp_old = r[2], c.damp_new = r[3], c.con_old = r[4],
+  c.con_new = r[5], c.ke = r[6];
+  energy_.internal = booked0[0] + r[11] + r[7];
+  energy_.eroded_internal = booked0[1] + r[12];
+  energy_.eroded_kinetic = booked0[2] + r[13];
+  energy_.stabilisation += r[8];
+  energy_.hourglass += r[9];
+  energy_.rotational_kinetic += r[10];
+  friction_all_ranks_ = r[14];
+  for (std::size_t k = 0; k < model_.tools.size(); ++k)
+    model_.tools[k].force = {r[15 + 3 * k], r[16 + 3 * k], r[17 + 3 * k]};
+  if (has_motion_forces_) std::copy(r.end() - 4, r.end(), motion_work_all_ranks_.begin());
+  timers_.exchange += seconds_since(tr);
+}
+
+// The works of the cycle, the tools' velocities over the next half step and their works, and the
+// energy balance at t^n.
+void ExplicitSolver::book_energies(const CycleArrays& a, Cycle& c) {
+  const double t_half = c.t_half, dt_mid = c.dt_mid, dt_new = c.dt_new;
+  double& ke = c.ke;
+  w_ext_.add(c.ext_old, c.ext_new);
+  w_damp_.add(c.damp_old, c.damp_new);
+  w_contact_nodes_.add(c.con_old, c.con_new);
+
+  // Tools: velocity over the next half step, and their work.
+  double tool_on_nodes_old = 0, tool_on_nodes_new = 0, tool_src_old = 0, tool_src_new = 0;
+  for (auto& tool : model_.tools) {
+    const V3 vo = tool.velocity;
+    V3 vn;
+    if (tool.motion.kind == ToolMotion::Kind::Velocity) {
+      vn = tool_prescribed_velocity(tool, t_half);
+    } else if (tool.motion.kind == ToolMotion::Kind::Force) {
+      const V3 ax = tool.motion.axis;
+      const double acc = (tool.motion.force + dot(tool.force, ax)) / tool.motion.mass;
+      vn = (dot(vo, ax) + dt_mid * acc) * ax;
+      ke += 0.5 * tool.motion.mass * dot(vo, vn);
+    }
+    tool.velocity = vn;
+    // The tool pushes the nodes with -tool.force.
+    tool_on_nodes_old += -dot(tool.force, dt_prev_ * vo);
+    tool_on_nodes_new += -dot(tool.force, dt_new * vn);
+    if (tool.motion.kind == ToolMotion::Kind::Velocity) {
+      tool_src_old += -dot(tool.force, dt_prev_ * vo);
+      tool_src_new += -dot(tool.force, dt_new * vn);
+    } else if (tool.motion.kind == ToolMotion::Kind::Force) {
+      const V3 F = tool.motion.force * tool.motion.axis;
+      tool_src_old += dot(F, dt_prev_ * vo);
+      tool_src_new += dot(F, dt_new * vn);
+    }
+  }
+  // Rigs' walls: driven like velocity tools, so their work on the nodes is the rig's (external)
+  // work; the contact energy keeps the penalty energy stored.
+  if (!domain_) {
+    for (auto& m : motions_)
+      if (m->has_forces())
+        m->add_force_work(t_ - 0.5 * dt_prev_, t_half, dt_prev_, dt_new, tool_src_old, tool_src_new,
+                          tool_on_nodes_old, tool_on_nodes_new);
+  } else if (has_motion_forces_) {  // summed over the ranks (sum_over_ranks)
+    const auto& mw = motion_work_all_ranks_;
+    tool_src_old += mw[0], tool_src_new += mw[1];
+    tool_on_nodes_old += mw[2], tool_on_nodes_new += mw[3];
+  }
+  w_tools_.add(tool_src_old, tool_src_new);
+  tool_work_on_nodes_.add(tool_on_nodes_old, tool_on_nodes_new);
+
+  energy_.time = t_;
+  energy_.kinetic = ke + energy_.rotational_kinetic;
+  energy_.external_work = w_ext_.committed + w_tools_.committed;
+  energy_.damping = -w_damp_.committed;
+  energy_.contact = tool_work_on_nodes_.committed - w_contact_nodes_.committed;
+  double fr = 0;
+  for (const auto& tool : model_.tools) fr += tool.friction_dissipation;
+  for (const auto& k : model_.contacts) fr += k->friction_dissipation();
+  energy_.friction = domain_ ? friction_all_ranks_ : fr;
+  energy_.scale_max = std::max(energy_.scale_max, energy_.scale());
+  if (!std::isfinite(ke)) check_finite(a.v);
+}
+
+// x^{n+1} (already moved in the velocity pass unless the callback reads x^n), the ghosts' x and
+// v from their owners, the tools' displacements, and the clock on to t^{n+1}.
+void ExplicitSolver::finish_cycle(const Cycle& c) {
+  const std::size_t nd = 3 * model_.mesh.n_nodes();
+  const double dt_new = c.dt_new;
+  if (!c.move_x_in_pass) {
     auto X = x.view();
     auto Vv = v.view();
     if (domain_) {
@@ -1052,7 +1099,7 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
     }
   }
   if (domain_) {
-    t0 = Clock::now();
+    const auto t0 = Clock::now();
     auto X = x.view();
     auto Vv = v.view();
     domain_->refresh_ghosts(X.data(), Vv.data());

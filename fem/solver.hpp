@@ -160,6 +160,37 @@ class ExplicitSolver {
   void load_state(CheckpointReader& r);
 
  private:
+  /// What one cycle's phases hand on to the next (step() runs them in order).
+  struct Cycle {
+    bool move_x_in_pass = true;  // x^{n+1} in the velocity pass (the callback does not read x^n)
+    bool has_ext = false, has_contact = false, has_damp = false;  // force kinds in use
+    std::array<double, 3> booked0{};  // internal, eroded internal and kinetic energy before it
+    ElementEnergyIncrement inc;       // the elements' energy increments (this rank's)
+    StableStep st;                    // the element that controls the step
+    double dt_new = 0, alpha = 0, t_half = 0, dt_mid = 0;
+    // Works over the increments around t^n (F.du_old, F.du_new per force kind) and the kinetic
+    // energy in product form: this rank's share until sum_over_ranks.
+    double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
+  };
+  /// The nodal arrays of a cycle ([3*n_nodes]; step() holds the vectors' views).
+  struct CycleArrays {
+    double* x;
+    double* v;
+    const double* x0;
+    const double* m;
+    double *fi, *fe, *fc, *fd, *r;  // internal, external, contact, damping forces, reactions
+  };
+  // The phases of step(), in order.
+  void internal_forces(const CycleArrays& a, Cycle& c);
+  void erode_and_choose_step(const CycleArrays& a, Cycle& c);
+  void contact_forces(const CycleArrays& a, Cycle& c);
+  void exchange_forces(const CycleArrays& a, Cycle& c);  // several ranks
+  void external_forces(const CycleArrays& a, Cycle& c);
+  void update_velocities(const CycleArrays& a, Cycle& c);
+  void sum_over_ranks(Cycle& c);  // several ranks
+  void book_energies(const CycleArrays& a, Cycle& c);
+  void finish_cycle(const Cycle& c);
+
   void build_blocks();
   void apply_mass_scaling();
   void assemble_mass();
@@ -203,8 +234,8 @@ class ExplicitSolver {
   std::vector<double> step_scratch_, jacobian_scratch_;
   std::vector<double> reduce_buffer_;  // per-cycle sums over the ranks
   std::vector<std::pair<std::size_t, std::size_t>> local_erosions_;  // (group, element) this cycle
-  bool eroded_any_ = false;
-  double friction_all_ranks_ = 0;  // several ranks: friction dissipated, summed this cycle  // several ranks: some rank eroded an element this cycle
+  bool eroded_any_ = false;        // several ranks: some rank eroded an element this cycle
+  double friction_all_ranks_ = 0;  // several ranks: friction dissipated, summed this cycle
   std::vector<std::vector<ContactResultant>> contact_resultants_;  // several ranks: summed
   std::vector<double> contact_max_penetration_;
   std::array<double, 4> motion_work_all_ranks_{};  // several ranks: the rigs' wall works, summed
