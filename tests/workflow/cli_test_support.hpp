@@ -38,10 +38,13 @@ inline std::string slurp(const fs::path& p) {
 
 /// Starts ncfsim with args, stdout and stderr into `log`; returns the child's pid. With a
 /// launcher (e.g. {mpiexec, -n, 2}) the child is the launcher, given ncfsim and args.
+/// With `own_process_group` the child leads a process group of its own (its pid), so that a
+/// signal to -pid reaches it and the MPI ranks its launcher starts, as Ctrl-C in a terminal does.
 inline pid_t spawn(const std::vector<std::string>& args, const fs::path& log,
-                   const std::vector<std::string>& launcher = {}) {
+                   const std::vector<std::string>& launcher = {}, bool own_process_group = false) {
   const pid_t pid = fork();
   if (pid == 0) {
+    if (own_process_group) setpgid(0, 0);
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(fd, 1);
     dup2(fd, 2);

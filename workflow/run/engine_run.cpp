@@ -260,20 +260,31 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
   if (!r.failure.empty()) r.summary["error"] = r.failure;
 }
 
+// On several ranks a checkpoint is collective (docs/parallel.md "Checkpoints"): every rank
+// writes its share, then the root commits checkpoint.h5 only if all did, and says so.
+bool all_ranks_wrote(const fem::ExplicitSolver& s, bool wrote) {
+  if (!s.domain()) return wrote;
+  int all = wrote ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &all, 1, MPI_INT, MPI_MIN, s.domain()->comm());
+  return all != 0;
+}
+bool root_committed(const fem::ExplicitSolver& s, bool committed) {
+  if (!s.domain()) return committed;
+  int c = committed ? 1 : 0;
+  MPI_Bcast(&c, 1, MPI_INT, 0, s.domain()->comm());
+  return c != 0;
+}
+
 // checkpoint.h5 at a cycle boundary (the top of the time loop): the whole state, atomically.
 // A checkpoint that cannot be written is logged; the run goes on.
 void write_checkpoint(Run& r, const fem::ExplicitSolver& s, const MeasureList& measures,
                       const RunHistory& history, const FrameOutput& frames) {
   if (r.checkpoint_cycle == s.cycle()) return;
-  if (s.domain()) {  // docs/parallel.md: not yet on several ranks
-    if (r.checkpoint_cycle != -2) r.log->warn("no checkpoints on several MPI ranks (yet)");
-    r.checkpoint_cycle = -2;
-    return;
-  }
   const auto t0 = Clock::now();
   const std::filesystem::path file = r.dir / kCheckpointFile;
+  std::string failure;
+  fem::CheckpointTree t;
   try {
-    fem::CheckpointTree t;
     write_checkpoint_header(t, r.ec, r.options, r.case_hash, s.time(), s.cycle(), r.wall_seconds(),
                             r.segments);
     s.save_state(t);
@@ -302,16 +313,70 @@ void write_checkpoint(Run& r, const fem::ExplicitSolver& s, const MeasureList& m
       frames.save_state(t);
       t.write_string("summary", r.summary.dump());
     }
-    fem::io::write_checkpoint_file(file, t);
+  } catch (const std::exception& e) {
+    failure = e.what();
+  }
+  if (!all_ranks_wrote(s, failure.empty()) && failure.empty())
+    failure = "another MPI rank could not write its state file (its message is on the console)";
+  if (failure.empty()) {
+    try {
+      fem::io::write_checkpoint_file(file, t);
+    } catch (const std::exception& e) {
+      failure = e.what();
+    }
+  }
+  root_committed(s, failure.empty());
+  if (failure.empty()) {
     r.checkpoint_cycle = s.cycle();
     std::error_code ec;
     const auto bytes = std::filesystem::file_size(file, ec);
-    r.log->info("checkpoint at t = {:.6g} s, cycle {} ({:.1f} MB, {:.2f} s)", s.time(), s.cycle(),
-                ec ? 0.0 : static_cast<double>(bytes) / 1e6, seconds_since(t0));
-  } catch (const std::exception& e) {
-    r.log->error("checkpoint at t = {:.6g} s not written: {}", s.time(), e.what());
+    r.log->info("checkpoint at t = {:.6g} s, cycle {} ({:.1f} MB{}, {:.2f} s)", s.time(), s.cycle(),
+                ec ? 0.0 : static_cast<double>(bytes) / 1e6,
+                s.domain() ? fmt::format(" and a state file from each of the {} other ranks",
+                                         s.domain()->size() - 1)
+                           : std::string(),
+                seconds_since(t0));
+  } else {
+    r.log->error("checkpoint at t = {:.6g} s not written: {}", s.time(), failure);
   }
   r.last_checkpoint = Clock::now();
+}
+
+// A rank other than the root in a checkpoint: its own state (the solver's share and the loop's
+// output times) into its state file, kept once the root has committed checkpoint.h5.
+struct RankCheckpoints {
+  std::filesystem::path dir;
+  std::string case_hash;
+  std::int64_t cycle = -1;  // of the last checkpoint committed or loaded
+};
+
+void write_rank_checkpoint(RankCheckpoints& ck, const fem::ExplicitSolver& s,
+                           const Run::LoopState& loop) {
+  if (ck.cycle == s.cycle()) return;
+  const int rank = s.domain()->rank();
+  const std::filesystem::path file = rank_checkpoint_file(ck.dir, rank, s.cycle());
+  bool wrote = true;
+  try {
+    fem::CheckpointTree t;
+    write_rank_checkpoint_header(t, ck.case_hash, rank, s.domain()->size(), s.cycle());
+    s.save_state(t);
+    fem::CheckpointScope<fem::CheckpointWriter> run(t, "run");
+    t.write_double("next_history", loop.next_history);
+    t.write_double("next_frame", loop.next_frame);
+    fem::io::write_checkpoint_file(file, t);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ncfsim: MPI rank %d: checkpoint state file %s not written: %s\n", rank,
+                 file.c_str(), e.what());
+    wrote = false;
+  }
+  all_ranks_wrote(s, wrote);
+  std::error_code err;
+  if (root_committed(s, false)) {
+    ck.cycle = s.cycle();
+    remove_rank_checkpoints(ck.dir, rank, ck.cycle);
+  } else {
+    std::filesystem::remove(file, err);
+  }
 }
 
 // Overwrites the state of the run just built from the same case with the checkpoint's.
@@ -400,12 +465,21 @@ void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size
       for (const auto& line : m->after_erosion(s)) log.warn("{}", line);
 }
 
-// Ctrl-C on any rank stops every rank at the same cycle (a rank that stopped alone would leave
-// the others waiting in the next exchange).
-bool stop_requested(const fem::ExplicitSolver& s) {
-  int stop = StopRequest::requested() ? 1 : 0;
-  if (s.domain()) MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, s.domain()->comm());
-  return stop != 0;
+// What the top of a cycle asks of every rank at once: stop (Ctrl-C on any rank: a rank that
+// stopped alone would leave the others waiting in the next exchange) and a checkpoint (the
+// root's wall-time interval has passed).
+struct LoopRequests {
+  bool stop = false, checkpoint = false;
+};
+LoopRequests loop_requests(const fem::ExplicitSolver& s, bool checkpoint_due) {
+  int flags = (StopRequest::requested() ? 1 : 0) | (checkpoint_due ? 2 : 0);
+  if (s.domain()) MPI_Allreduce(MPI_IN_PLACE, &flags, 1, MPI_INT, MPI_BOR, s.domain()->comm());
+  return {(flags & 1) != 0, (flags & 2) != 0};
+}
+
+bool checkpoint_every_cycles_due(const OutputSettings& out, const fem::ExplicitSolver& s) {
+  return out.checkpoint_every_cycles > 0 && s.cycle() > 0 &&
+         s.cycle() % out.checkpoint_every_cycles == 0;
 }
 
 // On several ranks the root gathers the whole state before a history row or a frame; the other
@@ -443,7 +517,10 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
         write_checkpoint(r, solver, measures, history, frames);
         break;
       }
-      if (stop_requested(solver)) {
+      const LoopRequests req = loop_requests(
+          solver, out.checkpoint_interval_min > 0 &&
+                      seconds_since(r.last_checkpoint) >= 60 * out.checkpoint_interval_min);
+      if (req.stop) {
         r.status = "interrupted";
         r.log->warn(
             "interrupted at t = {:.6g} s, cycle {}: writing a checkpoint, the last frame "
@@ -452,10 +529,7 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
         write_checkpoint(r, solver, measures, history, frames);
         break;
       }
-      if ((out.checkpoint_every_cycles > 0 && solver.cycle() > 0 &&
-           solver.cycle() % out.checkpoint_every_cycles == 0) ||
-          (out.checkpoint_interval_min > 0 &&
-           seconds_since(r.last_checkpoint) >= 60 * out.checkpoint_interval_min))
+      if (checkpoint_every_cycles_due(out, solver) || req.checkpoint)
         write_checkpoint(r, solver, measures, history, frames);
       // Only a history row or a frame reads x^n in the callback: in the other cycles the
       // positions move in the solver's velocity pass (one sweep over the nodal arrays).
@@ -581,7 +655,14 @@ void draw_figures_and_report(const Run& r) {
 }  // namespace
 
 int run_engine_worker(EngineCase& ec, const RunOptions& options) {
-  if (options.resume) return kBadInput;  // the root says why
+  RankCheckpoints ck{output_folder(ec, options), checkpoint_case_hash(ec.file, options.overrides)};
+  // --resume: the root checks checkpoint.h5 (and that every rank's file is there), then names
+  // its cycle, or -1 when it refuses the checkpoint (it reports why).
+  std::int64_t resume_cycle = -1;
+  if (options.resume) {
+    MPI_Bcast(&resume_cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
+    if (resume_cycle < 0) return kBadInput;
+  }
   std::unique_ptr<fem::ExplicitSolver> solver_ptr;
   try {
     solver_ptr = std::make_unique<fem::ExplicitSolver>(ec.model);
@@ -590,12 +671,42 @@ int run_engine_worker(EngineCase& ec, const RunOptions& options) {
   }
   fem::ExplicitSolver& solver = *solver_ptr;
   const auto& tc = solver.model().time;
+  const auto& out = ec.output;
   Run::LoopState loop;
+  if (options.resume) {
+    const int rank = solver.domain()->rank();
+    fem::CheckpointTree t =
+        read_rank_checkpoint(ck.dir, rank, solver.domain()->size(), resume_cycle, ck.case_hash);
+    try {
+      solver.load_state(t);
+      fem::CheckpointScope<fem::CheckpointReader> run(t, "run");
+      loop.next_history = t.read_double("next_history");
+      loop.next_frame = t.read_double("next_frame");
+    } catch (const fem::CheckpointMismatch& e) {
+      throw InputError(rank_checkpoint_file(ck.dir, rank, resume_cycle).string(), "--resume",
+                       std::string("does not fit this model: ") + e.what());
+    }
+    ck.cycle = resume_cycle;
+  }
   StopRequest::install();
+  bool completed = false;
   try {
-    while (solver.time() < tc.end_time * (1 - 1e-12)) {
-      if (tc.max_cycles > 0 && solver.cycle() >= tc.max_cycles) break;
-      if (stop_requested(solver)) break;
+    while (true) {
+      if (solver.time() >= tc.end_time * (1 - 1e-12)) {
+        completed = true;
+        break;
+      }
+      if (tc.max_cycles > 0 && solver.cycle() >= tc.max_cycles) {
+        write_rank_checkpoint(ck, solver, loop);
+        break;
+      }
+      const LoopRequests req = loop_requests(solver, false);
+      if (req.stop) {
+        write_rank_checkpoint(ck, solver, loop);
+        break;
+      }
+      if (checkpoint_every_cycles_due(out, solver) || req.checkpoint)
+        write_rank_checkpoint(ck, solver, loop);
       const auto at_tn = [&] {
         const double t = solver.time();
         if (!output_due(t, loop)) return;
@@ -609,6 +720,7 @@ int run_engine_worker(EngineCase& ec, const RunOptions& options) {
   } catch (const NumericalError&) {
     return kNumericalFailure;
   }
+  if (completed) remove_rank_checkpoints(ck.dir, solver.domain()->rank(), -1);
   return kSuccess;
 }
 
@@ -624,7 +736,18 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   r.case_hash = checkpoint_case_hash(ec.file, options.overrides);
   // --resume: the checkpoint is checked (version, case) before anything is written.
   fem::CheckpointTree checkpoint;
-  if (options.resume) checkpoint = read_run_checkpoint(r.dir, ec, r.case_hash);
+  if (options.resume) {
+    // The other ranks wait for the cycle to load: they get -1 when the checkpoint is refused.
+    std::int64_t cycle = -1;
+    try {
+      checkpoint = read_run_checkpoint(r.dir, ec, r.case_hash);
+      cycle = checkpoint.read_int("cycle");
+    } catch (...) {
+      if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
+      throw;
+    }
+    if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
+  }
   const OutputFolder folder =
       options.resume ? OutputFolder::resume(r.dir) : OutputFolder::claim(r.dir, options.overwrite);
   r.log = make_run_logger(r.dir, options.verbosity, options.resume);
@@ -634,9 +757,6 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
     write_figure_specs(r.dir, ec);
   }
   log_start(r);
-  if (options.resume && fem::PetscSession::size() > 1)
-    throw InputError(ec.file.string(), "--resume",
-                     "not yet on several MPI ranks (docs/parallel.md)");
 
   const auto solver_ptr = make_solver(ec, r);
   fem::ExplicitSolver& solver = *solver_ptr;
@@ -700,8 +820,11 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   const std::filesystem::path ck = r.dir / kCheckpointFile;
   std::error_code ec_exists;
   if (stopped && std::filesystem::exists(ck, ec_exists)) {
-    r.log->warn("checkpoint kept ({}): ncfsim run {} -o {}{} --resume continues the run",
-                ck.string(), r.ec.file.string(), r.dir.string(), [&] {
+    r.log->warn("checkpoint kept ({}): ncfsim run {} -o {}{}{} --resume continues the run",
+                ck.string(), r.ec.file.string(), r.dir.string(),
+                fem::PetscSession::size() > 1 ? fmt::format(" --np {}", fem::PetscSession::size())
+                                              : std::string(),
+                [&] {
                   std::string s;
                   for (const auto& ov : r.options.overrides)
                     if (ov.rfind("time.max_cycles=", 0) != 0) s += " --set " + ov;

@@ -28,8 +28,27 @@ void write_checkpoint_header(fem::CheckpointWriter& w, const EngineCase& ec,
 
 /// dir/checkpoint.h5, checked against this ncfsim and this case (the hash): ready to read.
 /// InputError (exit 2) naming the file: no checkpoint ("run without --resume"), not readable,
-/// another ncfsim version, another case or other overrides.
+/// another ncfsim version, another case or other overrides, written on another number of MPI
+/// ranks, or a rank's state file of that checkpoint missing.
 fem::CheckpointTree read_run_checkpoint(const std::filesystem::path& dir, const EngineCase& ec,
                                         const std::string& case_hash);
+
+// On several MPI ranks (docs/parallel.md "Checkpoints") every rank saves its own share of the
+// state: rank k > 0 into checkpoint.rank<k>.cycle<c>.h5, then the root, once every rank has
+// written its file, into checkpoint.h5, which names the cycle. A run killed between the two
+// resumes from the previous checkpoint, whose rank files are removed only after the root's.
+
+/// The state file of MPI rank `rank` > 0 for the checkpoint at `cycle`.
+std::filesystem::path rank_checkpoint_file(const std::filesystem::path& dir, int rank,
+                                           std::int64_t cycle);
+/// Removes the state files of `rank` except the one of `keep_cycle` (-1: all of them).
+void remove_rank_checkpoints(const std::filesystem::path& dir, int rank, std::int64_t keep_cycle);
+/// The root attributes of a rank's state file.
+void write_rank_checkpoint_header(fem::CheckpointWriter& w, const std::string& case_hash, int rank,
+                                  int ranks, std::int64_t cycle);
+/// Rank `rank`'s state file of the checkpoint at `cycle`, checked (version, case, rank, cycle):
+/// ready to read. InputError naming the file otherwise.
+fem::CheckpointTree read_rank_checkpoint(const std::filesystem::path& dir, int rank, int ranks,
+                                         std::int64_t cycle, const std::string& case_hash);
 
 }  // namespace ncfsim::workflow
