@@ -28,6 +28,7 @@
 #include "workflow/figures/figures.hpp"
 #include "workflow/report/report.hpp"
 #include "workflow/run/engine_run.hpp"
+#include "workflow/run/mpi_launch.hpp"
 #include "workflow/run/run_output.hpp"
 #include "workflow/stages/stage_registry.hpp"
 #include "workflow/stages/transfer_export.hpp"
@@ -39,13 +40,9 @@ namespace wf = ncfsim::workflow;
 namespace {
 
 // `ncfsim run ... --np N` outside a launcher: starts N ranks of this same executable with the
-// launcher CMake found, the same arguments less --np (docs/cli.md). Open MPI refuses to run as
-// root and more ranks than cores unless told: both allowed here, as the user asked for N.
+// launcher CMake found, the same arguments less --np (docs/cli.md).
 int relaunch_with_mpiexec(int ranks, int argc, char** argv) {
-  std::vector<std::string> args = {NCFSIM_MPIEXEC, "-n", std::to_string(ranks)};
-  char exe[4096];
-  const ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  args.emplace_back(len > 0 ? std::string(exe, static_cast<std::size_t>(len)) : argv[0]);
+  std::vector<std::string> args = wf::mpi_launch_command(ranks);
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--np") {
@@ -55,11 +52,6 @@ int relaunch_with_mpiexec(int ranks, int argc, char** argv) {
     if (a.rfind("--np=", 0) == 0) continue;
     args.push_back(a);
   }
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
-  // Oversubscribed, Open MPI yields the core while it waits (slower messages): only then.
-  if (static_cast<unsigned>(ranks) > std::thread::hardware_concurrency())
-    ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
   std::vector<char*> cargs;
   for (auto& a : args) cargs.push_back(a.data());
   cargs.push_back(nullptr);
@@ -123,6 +115,9 @@ int main(int argc, char** argv) {
   run->add_flag("--resume", resume,
                 "Continue an interrupted run in its output folder from its checkpoint.h5 (the "
                 "same case and --set; time.max_cycles may differ)");
+  std::string inputs_hash;  // a workflow's engine stage started on several ranks: its inputs hash
+  run->add_option("--inputs-hash", inputs_hash, "(internal: set by a workflow for its stages)")
+      ->group("");
   run->add_option("--progress-interval", progress, "Seconds between progress lines (default 5)")
       ->check(CLI::Validator(
           [](const std::string& s) {
@@ -313,7 +308,10 @@ int main(int argc, char** argv) {
       return wf::check_stage(call);
     }
     if (*run) {  // [case] kind -> its stage (workflow/stages/stage_registry.hpp)
-      if (ranks > 1 && !wf::started_by_mpi_launcher()) return relaunch_with_mpiexec(ranks, argc, argv);
+      // A workflow is not relaunched: it runs its engine stages on --np ranks each.
+      if (ranks > 1 && !wf::started_by_mpi_launcher() &&
+          wf::case_kind(case_file, overrides) != "workflow")
+        return relaunch_with_mpiexec(ranks, argc, argv);
       wf::StageCall call;
       call.case_file = case_file;
       call.overrides = overrides;
@@ -325,6 +323,7 @@ int main(int argc, char** argv) {
       call.options.force_stages = force_stages;
       call.options.overwrite = overwrite;
       call.options.resume = resume;
+      call.options.inputs_hash = inputs_hash;
       return wf::run_stage(call);
     }
     if (*compare) {

@@ -13,6 +13,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -177,6 +178,75 @@ TEST(MpiRunsResume, CheckpointOfTwoRanksIsRefusedOnOneOrWithoutItsRankFile) {
     fs::remove(moved);
   }
   fs::remove_all(r);
+}
+
+}  // namespace ncfsim::test
+
+namespace ncfsim::test {
+
+// A workflow with --np 2 runs its engine stage on 2 ranks (a launcher of its own, in a process
+// group of its own) and its kinematic stage on one. Ctrl-C to the workflow's process group (a
+// terminal's) stops the workflow, which passes one interrupt on to the stage's ranks: they
+// checkpoint at one cycle, the console gives the command with --np 2, and --resume continues the
+// stage to the history.csv of the uninterrupted 2-rank run. A rerun skips both stages.
+TEST(MpiRunsResume, WorkflowRunsItsEngineStageOnTwoRanksAndResumesIt) {
+  if (!launcher_works()) GTEST_SKIP() << "the MPI launcher does not start here";
+  const fs::path u = uninterrupted();
+  const fs::path dir = fresh_dir("mpi_resume_workflow");
+  fs::create_directories(dir);
+  std::ofstream(dir / "workflow.toml")
+      << "[case]\nname = \"two\"\nkind = \"workflow\"\n[[stage]]\nname = \"fishnet\"\ncase = \""
+      << (kSource / "cases/hemisphere/fishnet.toml").string()
+      << "\"\n[[stage]]\nname = \"sled\"\ncase = \"" << kSled.string()
+      << "\"\nafter = [\"fishnet\"]\n";
+  const fs::path out = dir / "out";
+  const std::vector<std::string> args = {"run",   (dir / "workflow.toml").string(),
+                                         "-o",    out.string(),
+                                         "--np",  "2",
+                                         "--set", "sled.time.end_time=0.012",
+                                         "--set", "sled.output.figures=false",
+                                         "--set", "sled.output.checkpoint_every_cycles=2000"};
+  const fs::path log = dir / "console.log";
+  const pid_t pid = spawn(args, log, {}, true);
+  ASSERT_TRUE(wait_for_checkpoints(out / "sled", 1)) << slurp(log);
+  kill(-pid, SIGINT);
+  EXPECT_EQ(wait_code(pid), 1) << slurp(log);
+  const std::string console = slurp(log);
+  EXPECT_NE(console.find("[2/2 sled] on 2 MPI ranks"), std::string::npos) << console;
+  EXPECT_NE(console.find("stage 'sled' kept its checkpoint"), std::string::npos) << console;
+  EXPECT_NE(console.find("--np 2 --set sled.time.end_time=0.012"), std::string::npos) << console;
+  EXPECT_EQ(summary(out / "sled")["status"], "interrupted");
+  EXPECT_EQ(rank_files(out / "sled").size(), 1u);
+  std::vector<std::string> again = args;
+  again.push_back("--resume");
+  const auto res = run_cli(again);
+  ASSERT_EQ(res.code, 0) << res.output;
+  EXPECT_NE(res.output.find("[1/2 fishnet] unchanged"), std::string::npos) << res.output;
+  EXPECT_NE(res.output.find("resuming from its checkpoint"), std::string::npos) << res.output;
+  EXPECT_EQ(slurp(u / "history.csv"), slurp(out / "sled/history.csv"));
+  EXPECT_EQ(summary(out / "sled")["mpi_ranks"].get<int>(), 2);
+  const auto ws = summary(out);
+  EXPECT_EQ(ws["stages"][0]["mpi_ranks"].get<int>(), 1);
+  EXPECT_EQ(ws["stages"][1]["mpi_ranks"].get<int>(), 2);
+  const auto rerun = run_cli(args);
+  ASSERT_EQ(rerun.code, 0) << rerun.output;
+  EXPECT_NE(rerun.output.find("[2/2 sled] unchanged"), std::string::npos) << rerun.output;
+  fs::remove_all(dir);
+}
+
+// `ranks` of a stage that is not split over ranks is bad input naming the stage.
+TEST(MpiRunsResume, WorkflowRefusesRanksForAKinematicStage) {
+  const fs::path dir = fresh_dir("mpi_workflow_ranks");
+  fs::create_directories(dir);
+  std::ofstream(dir / "workflow.toml")
+      << "[case]\nname = \"one\"\nkind = \"workflow\"\n[[stage]]\nname = \"fishnet\"\ncase = \""
+      << (kSource / "cases/hemisphere/fishnet.toml").string() << "\"\nranks = 2\n";
+  const auto res = run_cli({"run", (dir / "workflow.toml").string(), "-o", (dir / "out").string()});
+  EXPECT_EQ(res.code, 2) << res.output;
+  EXPECT_NE(res.output.find("stage.ranks"), std::string::npos) << res.output;
+  EXPECT_NE(res.output.find("stage 'fishnet' is a 'kinematic_drape' stage"), std::string::npos)
+      << res.output;
+  fs::remove_all(dir);
 }
 
 }  // namespace ncfsim::test

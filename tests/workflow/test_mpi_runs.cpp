@@ -169,10 +169,14 @@ TEST(MpiRuns, WhatCannotBeSplitIsRefused) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("cannot run on several MPI ranks yet"), std::string::npos) << r.output;
 
+  // A workflow started by mpirun (`--np` runs its engine stages on N ranks each instead:
+  // tests/workflow/test_mpi_resume.cpp).
   r = run_cli({"run", (kSource / "cases/hemisphere/ci/workflow.toml").string(), "-o",
-               fresh_dir("mpi_workflow").string(), "--np", "2"});
+               fresh_dir("mpi_workflow").string()},
+              {kMpiexec, "-n", "2"});
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("runs on one MPI rank"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("runs its engine stages on N ranks"), std::string::npos) << r.output;
   for (const char* d : {"mpi_np0", "mpi_too_many", "mpi_shells", "mpi_workflow"})
     fs::remove_all(fresh_dir(d));
 }

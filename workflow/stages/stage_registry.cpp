@@ -161,6 +161,10 @@ int run_stage(const StageCall& call) {
         "a '" + kind + "' stage keeps no checkpoint (it is short): run it without --resume");
   // Several ranks (docs/parallel.md): the time-loop runs only. Read from the launcher's
   // environment: the other stages never start MPI.
+  if (kind == "workflow" && launcher_world_size() > 1)
+    throw InputError(call.case_file.string(), "--np",
+                     "a workflow runs on one MPI rank: start it without mpirun; `ncfsim run "
+                     "WORKFLOW --np N` runs its engine stages on N ranks each");
   if (kind != "engine" && kind != "crush" && launcher_world_size() > 1)
     throw InputError(call.case_file.string(), "--np",
                      "a '" + kind + "' stage runs on one MPI rank (only engine and crush cases " +

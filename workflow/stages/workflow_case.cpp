@@ -84,6 +84,7 @@ WorkflowCase load_workflow_case(const std::filesystem::path& file,
     for (const auto& [key, up] : s.inputs) s.after.push_back(up);
     if (t.has("after"))
       for (const auto& up : t.strings("after")) s.after.push_back(up);
+    s.ranks = static_cast<int>(t.integer("ranks", 0, 1, 4096));
     std::sort(s.after.begin(), s.after.end());
     s.after.erase(std::unique(s.after.begin(), s.after.end()), s.after.end());
     wc.stages.push_back(std::move(s));

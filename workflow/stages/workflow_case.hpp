@@ -26,6 +26,7 @@ struct WorkflowStageSpec {
   std::vector<std::pair<std::string, std::string>> inputs;
   std::vector<std::string> after;      // upstream stages (inputs' stages and `after`), unique
   std::vector<std::string> overrides;  // --set items routed to this stage (key without the stage)
+  int ranks = 0;  // `ranks`: MPI ranks of an engine/crush stage (0: the workflow's --np)
 };
 
 struct WorkflowCase {

@@ -2,10 +2,15 @@
 
 #include <fmt/format.h>
 #include <spdlog/logger.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -20,6 +25,7 @@
 #include "workflow/output/output_files.hpp"
 #include "workflow/render/render.hpp"
 #include "workflow/report/report.hpp"
+#include "workflow/run/mpi_launch.hpp"
 #include "workflow/run/run_checkpoint.hpp"
 #include "workflow/run/run_output.hpp"
 #include "workflow/stages/workflow_case.hpp"
@@ -40,8 +46,11 @@ struct StagePlan {
   std::vector<std::string> overrides;  // routed + inputs
   std::string kind;
   std::string hash;
-  json inputs;  // what the hash covers (stage_inputs.json)
+  json inputs;    // what the hash covers (stage_inputs.json)
+  int ranks = 1;  // MPI ranks it runs on (several: a launcher of its own, run_on_ranks)
 };
+
+bool time_loop_kind(const std::string& kind) { return kind == "engine" || kind == "crush"; }
 
 // The stage's inputs and their hash; the upstream hashes are those of plans already made.
 void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream_hash) {
@@ -86,7 +95,7 @@ bool unchanged(const StagePlan& p) {
          sum.value("status", "") == "completed";
 }
 
-std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out) {
+std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out, int ranks) {
   std::vector<StagePlan> plans;
   std::map<std::string, std::string> hashes;
   for (const auto& s : wc.stages) {
@@ -103,6 +112,12 @@ std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out) {
           wc.file.string(), "stage",
           "stage '" + s.name + "' is itself a workflow (" + s.case_file.string() + ")");
     find_stage(p.kind, s.case_file);  // a known kind, or bad input naming the stage's file
+    if (s.ranks > 1 && !time_loop_kind(p.kind))
+      throw InputError(wc.file.string(), "stage.ranks",
+                       "stage '" + s.name + "' is a '" + p.kind +
+                           "' stage: it runs on one MPI rank (only engine and crush stages are "
+                           "split over ranks): ranks = 1 or leave it out");
+    p.ranks = s.ranks > 0 ? s.ranks : time_loop_kind(p.kind) ? ranks : 1;
     hash_stage(p, hashes);
     hashes[s.name] = p.hash;
     plans.push_back(std::move(p));
@@ -115,6 +130,77 @@ struct StageOutcome {
   std::string status;  // the stage's summary status, or bad_input / numerical_failure / failed
   std::string error;   // the message of bad input or a numerical failure thrown by the stage
 };
+
+// An engine or crush stage on several ranks: `launcher -n N ncfsim run CASE -o FOLDER --set ...`
+// as a child process in a process group of its own (so that the terminal's Ctrl-C reaches the
+// workflow only, which passes one SIGINT on to the stage's ranks: they checkpoint at one cycle).
+// The child gets SIGTERM if the workflow dies. Returns the child's exit code.
+int run_on_ranks(const StagePlan& p, const StageCall& sc, spdlog::logger& log,
+                 const std::string& tag) {
+  if (std::string(mpi_launcher()).empty())
+    throw InputError(p.spec.case_file.string(), "--np",
+                     "no MPI launcher was found when ncfsim was built: run the stage on one rank "
+                     "(ranks = 1 in the workflow's [[stage]], or no --np)");
+  std::vector<std::string> args = mpi_launch_command(p.ranks);
+  if (sc.options.verbosity == Verbosity::Quiet) args.push_back("-q");
+  if (sc.options.verbosity == Verbosity::Verbose) args.push_back("-v");
+  for (const char* a : {"run", sc.case_file.c_str(), "-o", sc.options.out_dir.c_str()})
+    args.emplace_back(a);
+  for (const auto& ov : sc.overrides) {
+    args.emplace_back("--set");
+    args.push_back(ov);
+  }
+  args.emplace_back("--progress-interval");
+  args.push_back(fmt::format("{}", sc.options.progress_interval_s));
+  args.emplace_back("--inputs-hash");
+  args.push_back(sc.options.inputs_hash);
+  if (sc.options.resume) args.emplace_back("--resume");
+  std::string shown;
+  for (std::size_t k = 0; k < args.size(); ++k)
+    if (!(k > 0 && args[k - 1] == "--inputs-hash")) shown += (shown.empty() ? "" : " ") + args[k];
+  log.info("{} on {} MPI ranks: {}", tag, p.ranks, shown);
+  log.flush();
+  std::vector<char*> cargs;
+  for (auto& a : args) cargs.push_back(a.data());
+  cargs.push_back(nullptr);
+  std::vector<std::string> env = launcher_environment();
+  std::vector<char*> cenv;
+  for (auto& e : env) cenv.push_back(e.data());
+  cenv.push_back(nullptr);
+  std::fflush(nullptr);
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0)
+    throw std::runtime_error(std::string("cannot start the stage's ranks: ") +
+                             std::strerror(errno));
+  if (pid == 0) {
+    setpgid(0, 0);
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(kOtherError);  // the workflow died before prctl
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE}) std::signal(sig, SIG_DFL);
+    execve(cargs[0], cargs.data(), cenv.data());
+    std::fprintf(stderr, "ncfsim: cannot start the MPI launcher '%s': %s\n", cargs[0],
+                 std::strerror(errno));
+    _exit(kBadInput);
+  }
+  setpgid(pid, pid);  // also here: no window where a signal to -pid misses it
+  bool passed_on = false;
+  int status = 0;
+  while (true) {
+    const pid_t r = waitpid(pid, &status, WNOHANG);
+    if (r == pid) break;
+    if (r < 0 && errno != EINTR) return kOtherError;
+    if (StopRequest::requested() && !passed_on) {
+      kill(-pid, SIGINT);
+      passed_on = true;
+      log.info("{} interrupt passed on to the stage's ranks", tag);
+    }
+    usleep(50'000);
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  log.error("{} the stage's launcher ended by signal {}", tag, WTERMSIG(status));
+  return kOtherError;
+}
 
 // Runs one stage into its folder; its stage_inputs.json is removed first, so a stage stopped
 // half-way is never taken as done.
@@ -149,7 +235,8 @@ StageOutcome run_planned_stage(const StagePlan& p, const RunOptions& options, sp
   }
   StageOutcome o;
   try {
-    o.rc = find_stage(p.kind, p.spec.case_file).run(sc);
+    o.rc =
+        p.ranks > 1 ? run_on_ranks(p, sc, log, tag) : find_stage(p.kind, p.spec.case_file).run(sc);
   } catch (const InputError& e) {
     o.rc = kBadInput;
     o.error = e.what();
@@ -159,6 +246,9 @@ StageOutcome run_planned_stage(const StagePlan& p, const RunOptions& options, sp
     o.error = e.what();
     log.error("{} numerical failure: {}", tag, e.what());
   }
+  if (p.ranks > 1 && o.rc != kSuccess && o.error.empty())
+    o.error = fmt::format("exit {} on {} MPI ranks (its message is above and in {})", o.rc, p.ranks,
+                          (p.folder / "log.txt").string());
   const json ss = read_json_file(p.folder / "summary.json");
   o.status = ss.is_object() ? ss.value("status", "failed") : "failed";
   if (o.rc == kBadInput)
@@ -180,7 +270,7 @@ int run_workflow_stage(const StageCall& call) {
                      [&](const auto& s) { return s.name == f; }))
       throw InputError(call.case_file.string(), "--force",
                        "'" + f + "' is not a stage of this workflow");
-  const std::vector<StagePlan> plans = plan(wc, out);
+  const std::vector<StagePlan> plans = plan(wc, out, call.options.ranks);
   // One PETSc/MPI session over every stage: MPI cannot start again once a stage's own session
   // has finalised it (the stages' sessions nest in this one).
   fem::PetscSession petsc;
@@ -213,11 +303,9 @@ int run_workflow_stage(const StageCall& call) {
   for (std::size_t k = 0; k < n; ++k) {
     const StagePlan& p = plans[k];
     const std::string tag = fmt::format("[{}/{} {}]", k + 1, n, p.spec.name);
-    json entry = {{"name", p.spec.name},
-                  {"kind", p.kind},
-                  {"case_file", p.spec.case_file.string()},
-                  {"folder", p.spec.name},
-                  {"inputs_hash", p.hash}};
+    json entry = {
+        {"name", p.spec.name},   {"kind", p.kind},        {"case_file", p.spec.case_file.string()},
+        {"folder", p.spec.name}, {"inputs_hash", p.hash}, {"mpi_ranks", p.ranks}};
     if (!stop_reason.empty()) {
       entry["status"] = "not_run";
       summary["stages"].push_back(entry);
@@ -285,6 +373,7 @@ int run_workflow_stage(const StageCall& call) {
         kept += (kept.empty() ? "" : ", ") + e["name"].get<std::string>();
     if (resumable) {
       std::string command = "ncfsim run " + call.case_file.string() + " -o " + out.string();
+      if (call.options.ranks > 1) command += " --np " + std::to_string(call.options.ranks);
       for (const auto& ov : call.overrides)  // a cycle limit would stop it again
         if (ov.find("time.max_cycles=") == std::string::npos) command += " --set " + ov;
       log->warn(
