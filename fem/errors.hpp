@@ -54,6 +54,7 @@ class InputError : public std::runtime_error {
   InputError(std::string file, std::string key, const std::string& message, std::string value = {},
              std::string allowed = {})
       : std::runtime_error(format(file, key, message)),
+        message_(message),
         file_(std::move(file)),
         key_(std::move(key)),
         value_(std::move(value)),
@@ -79,6 +80,7 @@ class InputError : public std::runtime_error {
   const std::string& key() const { return key_; }
   const std::string& value() const { return value_; }      // "" when not known
   const std::string& allowed() const { return allowed_; }  // "" when not known
+  const std::string& message() const { return message_; }  // without the file and key
 
  private:
   static std::string format(const std::string& file, const std::string& key,
@@ -88,7 +90,7 @@ class InputError : public std::runtime_error {
     if (!key.empty()) s += "key '" + key + "': ";
     return s + message;
   }
-  std::string file_, key_, value_, allowed_;
+  std::string message_, file_, key_, value_, allowed_;
 };
 
 /// The one range check of a value that does not come through the case reader's typed getters

@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "tests/workflow/cli_test_support.hpp"
+#include "tests/workflow/run_folder_support.hpp"
 
 namespace ncfsim::test {
 namespace {
@@ -48,10 +49,6 @@ std::vector<std::string> sled_run(const fs::path& out, std::vector<std::string> 
                                 "output.checkpoint_every_cycles=2000"};
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
-}
-
-nlohmann::json summary(const fs::path& out) {
-  return nlohmann::json::parse(slurp(out / "summary.json"));
 }
 
 std::vector<std::string> rank_files(const fs::path& out) {
@@ -90,21 +87,6 @@ void expect_same_results(const fs::path& u, const fs::path& r) {
   }
 }
 
-int count(const std::string& text, const std::string& what) {
-  int n = 0;
-  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
-  return n;
-}
-
-bool wait_for_checkpoints(const fs::path& out, int n) {
-  for (int i = 0; i < 9000; ++i) {
-    if (fs::exists(out / "log.txt") && count(slurp(out / "log.txt"), "checkpoint at t =") >= n)
-      return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return false;
-}
-
 }  // namespace
 
 TEST(MpiRunsResume, KilledOnTwoRanksAndResumedGivesTheSameResults) {
@@ -113,7 +95,7 @@ TEST(MpiRunsResume, KilledOnTwoRanksAndResumedGivesTheSameResults) {
   const fs::path r = fresh_dir("mpi_resume_sigkill");
   const fs::path log = r.string() + ".log";
   const pid_t pid = spawn(sled_run(r), log, {}, true);
-  ASSERT_TRUE(wait_for_checkpoints(r, 2)) << slurp(log);
+  ASSERT_TRUE(wait_for_checkpoints(r, 2, 90)) << slurp(log);
   kill(-pid, SIGKILL);
   wait_code(pid);
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the ranks, reparented
@@ -133,7 +115,7 @@ TEST(MpiRunsResume, CtrlCStopsEveryRankAtOneCycleAndTheRunResumes) {
   const fs::path r = fresh_dir("mpi_resume_sigint");
   const fs::path log = r.string() + ".log";
   const pid_t pid = spawn(sled_run(r), log, {}, true);
-  ASSERT_TRUE(wait_for_checkpoints(r, 1)) << slurp(log);
+  ASSERT_TRUE(wait_for_checkpoints(r, 1, 90)) << slurp(log);
   kill(-pid, SIGINT);
   wait_code(pid);
   EXPECT_EQ(summary(r)["status"], "interrupted") << slurp(log);
@@ -208,7 +190,7 @@ TEST(MpiRunsResume, WorkflowRunsItsEngineStageOnTwoRanksAndResumesIt) {
                                          "--set", "sled.output.checkpoint_every_cycles=2000"};
   const fs::path log = dir / "console.log";
   const pid_t pid = spawn(args, log, {}, true);
-  ASSERT_TRUE(wait_for_checkpoints(out / "sled", 1)) << slurp(log);
+  ASSERT_TRUE(wait_for_checkpoints(out / "sled", 1, 90)) << slurp(log);
   kill(-pid, SIGINT);
   EXPECT_EQ(wait_code(pid), 1) << slurp(log);
   const std::string console = slurp(log);

@@ -163,6 +163,8 @@ TEST(MpiRuns, WhatCannotBeSplitIsRefused) {
   r = run_cli({"run", cantilever, "-o", fresh_dir("mpi_too_many").string(), "--np", "2"});
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("2 MPI ranks for 20 elements"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("cantilever.toml: key '--np': 2 MPI ranks"), std::string::npos)
+      << "the case file and the key, each once: " << r.output;
 
   r = run_cli({"run", (kSource / "cases/verification/shell_cantilever.toml").string(), "-o",
                fresh_dir("mpi_shells").string(), "--np", "2"});

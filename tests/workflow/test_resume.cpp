@@ -19,6 +19,7 @@
 #include "fem/io/result_reader.hpp"
 #include "tests/flat_blanket_case.hpp"
 #include "tests/workflow/cli_test_support.hpp"
+#include "tests/workflow/run_folder_support.hpp"
 
 namespace ncfsim::test {
 namespace {
@@ -41,16 +42,6 @@ std::vector<std::string> sled_run(const fs::path& out, std::vector<std::string> 
                                 "output.checkpoint_every_cycles=2000"};
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
-}
-
-nlohmann::json summary(const fs::path& out) {
-  return nlohmann::json::parse(slurp(out / "summary.json"));
-}
-
-int count(const std::string& text, const std::string& what) {
-  int n = 0;
-  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
-  return n;
 }
 
 // The uninterrupted run, once for all tests.
@@ -86,15 +77,6 @@ void expect_same_results(const fs::path& u, const fs::path& r) {
     EXPECT_EQ(fu.cycle, fr.cycle);
     EXPECT_EQ(fu.coordinates, fr.coordinates) << "frame " << k;
   }
-}
-
-// Waits until log.txt of `out` holds `n` checkpoint lines (false after ~60 s).
-bool wait_for_checkpoints(const fs::path& out, int n) {
-  for (int i = 0; i < 6000; ++i) {
-    if (count(slurp(out / "log.txt"), "checkpoint at t =") >= n) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return false;
 }
 
 TEST(CliRegressionResume, KilledWithSigkillAndResumedGivesTheSameResults) {
@@ -200,9 +182,11 @@ TEST(CliRegressionResume, WorkflowStoppedInAStageResumesIt) {
   EXPECT_EQ(slurp(w1 / "b/history.csv"), slurp(w2 / "b/history.csv"));
   const auto s1 = summary(w1 / "b"), s2 = summary(w2 / "b");
   EXPECT_EQ(s2["status"], "completed");
-  for (const auto& [key, value] : s1.items())
-    if (value.is_number_float() && key != "wall_seconds" && key != "peak_memory_MB")
+  for (const auto& [key, value] : s1.items()) {
+    if (value.is_number_float() && key != "wall_seconds" && key != "peak_memory_MB") {
       EXPECT_EQ(value, s2[key]) << key;
+    }
+  }
   EXPECT_TRUE(fs::exists(w2 / "c/summary.json"));
 }
 

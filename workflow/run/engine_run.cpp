@@ -233,7 +233,9 @@ std::unique_ptr<fem::ExplicitSolver> make_solver(EngineCase& ec, Run& r) {
     r.summary["status"] = "bad_input";
     r.summary["error"] = e.what();
     r.write_summary();
-    throw InputError(ec.file.string(), e.key(), std::string(e.what()));
+    if (!e.file().empty()) throw;
+    // The model's checks name the key; the case file is this run's.
+    throw InputError(ec.file.string(), e.key(), e.message(), e.value(), e.allowed());
   }
 }
 

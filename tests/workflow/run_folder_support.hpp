@@ -1,0 +1,35 @@
+#pragma once
+// Helpers of the tests that stop and resume runs: a run folder's summary.json, and waiting until
+// its log.txt shows a number of checkpoints.
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+
+#include "tests/workflow/cli_test_support.hpp"
+
+namespace ncfsim::test {
+
+inline nlohmann::json summary(const fs::path& out) {
+  return nlohmann::json::parse(slurp(out / "summary.json"));
+}
+
+/// How many times `what` occurs in `text`.
+inline int count(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+/// Waits until log.txt of `out` holds `n` checkpoint lines (false after `seconds`).
+inline bool wait_for_checkpoints(const fs::path& out, int n, double seconds = 60) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (fs::exists(out / "log.txt") && count(slurp(out / "log.txt"), "checkpoint at t =") >= n)
+      return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+}  // namespace ncfsim::test
