@@ -381,12 +381,16 @@ void ExplicitSolver::gather_for_output() {
   }
 }
 
+// On several ranks the sums of the last output gather; before the first (a run that failed in
+// its first cycle) this rank's own.
 std::vector<ContactResultant> ExplicitSolver::contact_resultants(std::size_t k) const {
-  return domain_ ? contact_resultants_.at(k) : model_.contacts.at(k)->resultants();
+  return domain_ && k < contact_resultants_.size() ? contact_resultants_[k]
+                                                   : model_.contacts.at(k)->resultants();
 }
 
 double ExplicitSolver::contact_max_penetration(std::size_t k) const {
-  return domain_ ? contact_max_penetration_.at(k) : model_.contacts.at(k)->max_penetration();
+  return domain_ && k < contact_max_penetration_.size() ? contact_max_penetration_[k]
+                                                        : model_.contacts.at(k)->max_penetration();
 }
 
 std::size_t ExplicitSolver::n_elements(ElementKind kind) const {

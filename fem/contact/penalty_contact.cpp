@@ -226,6 +226,7 @@ bool PenaltyContact::closer_adjacent_face(const double* x, const std::int32_t* a
 
 bool PenaltyContact::nodes_to_read(const std::uint8_t* owned, const double* x0, double halo,
                                    std::vector<std::int32_t>& out) const {
+  halo_ = halo;
   // Cells of size `halo` holding an owned surface node, and their neighbours: a segment with a
   // corner in one of them is within 2 sqrt(3) halo of an owned node (at least `halo`).
   const auto key = [&](const double* p) {
@@ -273,6 +274,16 @@ void PenaltyContact::restrict_to_rank(const std::uint8_t* owned, const std::uint
     const std::size_t blk = s / kFrameLanes;
     if (!seg_remote_[s] && (frame_blocks_.empty() || frame_blocks_.back() != blk))
       frame_blocks_.push_back(blk);
+  }
+  seg_halo_edge_.assign(surf_.n_segments(), 0);
+  for (std::size_t e = 0; e < surf_.n_nodes(); ++e) {
+    bool edge = false;
+    for (std::int32_t r = node_seg_start_[e]; r < node_seg_start_[e + 1]; ++r)
+      edge = edge || seg_remote_[static_cast<std::size_t>(node_seg_[static_cast<std::size_t>(r)])];
+    for (std::int32_t r = node_seg_start_[e]; edge && r < node_seg_start_[e + 1]; ++r) {
+      const auto q = static_cast<std::size_t>(node_seg_[static_cast<std::size_t>(r)]);
+      if (!seg_remote_[q]) seg_halo_edge_[q] = 1;
+    }
   }
   collect_active_segments();
   box_lo_.resize(3 * active_seg_.size());
@@ -394,6 +405,17 @@ void PenaltyContact::sort_segments(const double* x) {
       bool own = false;
       for (int k = 0; k < 8; ++k) own = own || en[k] == static_cast<std::int32_t>(i);
       if (own) continue;  // a face of an element holding the node
+      if (!seg_halo_edge_.empty() && seg_halo_edge_[s])
+        throw NumericalError(
+            "contact '" + cfg_.name + "': surface node " + std::to_string(i + 1) + " at (" +
+            std::to_string(p[0]) + ", " + std::to_string(p[1]) + ", " + std::to_string(p[2]) +
+            ") m reached the edge of the segments this rank reads (those within [parallel] "
+            "contact_halo = " +
+            std::to_string(halo_) +
+            " m of its surface nodes at the start): the surfaces slid about that far relative "
+            "to each other across the partition, or the halo is small for this mesh, and "
+            "contacts beyond it would be missed; raise parallel.contact_halo or run on fewer "
+            "ranks");
       cand_seg_.push_back(static_cast<std::int32_t>(s));
       cand_facet_.push_back(static_cast<std::uint8_t>(facet));
     }

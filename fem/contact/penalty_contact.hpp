@@ -190,6 +190,11 @@ class PenaltyContact final : public ContactAlgorithm {
   // Several ranks: [n_seg] 1: a segment this rank cannot read (beyond its halo); [n_snode] 1: a
   // surface node this rank owns (empty on one rank: every node).
   std::vector<std::uint8_t> seg_remote_, node_mine_;
+  // Several ranks: segments this rank reads that share a corner with one it does not (the edge
+  // of its contact halo). An owned node finding one among its candidates has slid about the
+  // halo's width relative to the other surface: the contact beyond would be missed.
+  std::vector<std::uint8_t> seg_halo_edge_;
+  mutable double halo_ = 0;                  // set by nodes_to_read, for the message
   std::vector<std::int32_t> node_readable_;  // surface nodes this rank reads
   std::vector<std::size_t> frame_blocks_;    // frame blocks holding a segment it reads
   bool resort_ = false;  // the surface changed: sort before the next cycle

@@ -182,3 +182,23 @@ TEST(MpiRuns, WhatCannotBeSplitIsRefused) {
   for (const char* d : {"mpi_np0", "mpi_too_many", "mpi_shells", "mpi_workflow"})
     fs::remove_all(fresh_dir(d));
 }
+
+// A contact halo too small for the sliding (here for the mesh itself: 2 mm against tow elements
+// of about that size): an owned node reaches the edge of the segments its rank reads, and the run
+// stops with exit 3 naming the contact, the node and the key, instead of missing contacts.
+TEST(MpiRuns, ContactReachingTheEdgeOfTheHaloStopsTheRun) {
+  if (!launcher_works()) GTEST_SKIP() << "the MPI launcher does not start here";
+  const fs::path out = fresh_dir("mpi_halo_edge");
+  const Result r =
+      run_cli({"run", (kSource / "cases/drape/friction_sled_tow_tow_0_90.toml").string(), "-o",
+               out.string(), "--np", "2", "--set", "output.figures=false", "--set",
+               "parallel.contact_halo=0.002"});
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("contact 'tow_tow': surface node"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("reached the edge of the segments this rank reads"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("raise parallel.contact_halo"), std::string::npos) << r.output;
+  const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_EQ(s["status"], "numerical_failure");
+  fs::remove_all(out);
+}

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <sstream>
 
@@ -719,7 +720,10 @@ int run_engine_worker(EngineCase& ec, const RunOptions& options) {
       solver.step(at_tn, output_due(solver.time(), loop));  // x^n read only for output
     }
     solver.gather_for_output();
-  } catch (const NumericalError&) {
+  } catch (const NumericalError& e) {
+    // The root cannot report it (the launcher ends the job when this rank exits): say it here.
+    std::fprintf(stderr, "ncfsim: numerical failure on MPI rank %d: %s\n", solver.domain()->rank(),
+                 e.what());
     return kNumericalFailure;
   }
   if (completed) remove_rank_checkpoints(ck.dir, solver.domain()->rank(), -1);
