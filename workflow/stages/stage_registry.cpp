@@ -152,10 +152,12 @@ std::string case_kind(const std::filesystem::path& file,
   return *kind;
 }
 
+bool is_time_loop_kind(const std::string& kind) { return kind == "engine" || kind == "crush"; }
+
 int run_stage(const StageCall& call) {
   const std::string kind = case_kind(call.case_file, call.overrides);
   // Only time-loop runs write checkpoints; the other stages are short and rerun.
-  if (call.options.resume && kind != "engine" && kind != "crush" && kind != "workflow")
+  if (call.options.resume && !is_time_loop_kind(kind) && kind != "workflow")
     throw InputError(
         call.case_file.string(), "--resume",
         "a '" + kind + "' stage keeps no checkpoint (it is short): run it without --resume");
@@ -165,7 +167,7 @@ int run_stage(const StageCall& call) {
     throw InputError(call.case_file.string(), "--np",
                      "a workflow runs on one MPI rank: start it without mpirun; `ncfsim run "
                      "WORKFLOW --np N` runs its engine stages on N ranks each");
-  if (kind != "engine" && kind != "crush" && launcher_world_size() > 1)
+  if (!is_time_loop_kind(kind) && launcher_world_size() > 1)
     throw InputError(call.case_file.string(), "--np",
                      "a '" + kind + "' stage runs on one MPI rank (only engine and crush cases " +
                          "are split over ranks): run it without --np / mpirun, or give --np to " +

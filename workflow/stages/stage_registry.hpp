@@ -42,6 +42,10 @@ const Stage& find_stage(const std::string& kind, const std::filesystem::path& fi
 /// a file that does not parse or a kind that is not a string.
 std::string case_kind(const std::filesystem::path& file, const std::vector<std::string>& overrides);
 
+/// Whether a stage kind is a time-loop run (engine, crush): the kinds that keep checkpoints and
+/// are split over MPI ranks; the others are short and run on one rank.
+bool is_time_loop_kind(const std::string& kind);
+
 /// Looks the case's kind up and runs its stage.
 int run_stage(const StageCall& call);
 /// Looks the case's kind up and checks it (`ncfsim check`).

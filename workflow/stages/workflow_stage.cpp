@@ -50,8 +50,6 @@ struct StagePlan {
   int ranks = 1;  // MPI ranks it runs on (several: a launcher of its own, run_on_ranks)
 };
 
-bool time_loop_kind(const std::string& kind) { return kind == "engine" || kind == "crush"; }
-
 // The stage's inputs and their hash; the upstream hashes are those of plans already made.
 void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream_hash) {
   const fem::CaseDocument doc = fem::CaseDocument::load(p.spec.case_file, p.overrides);
@@ -112,12 +110,12 @@ std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out, int ran
           wc.file.string(), "stage",
           "stage '" + s.name + "' is itself a workflow (" + s.case_file.string() + ")");
     find_stage(p.kind, s.case_file);  // a known kind, or bad input naming the stage's file
-    if (s.ranks > 1 && !time_loop_kind(p.kind))
+    if (s.ranks > 1 && !is_time_loop_kind(p.kind))
       throw InputError(wc.file.string(), "stage.ranks",
                        "stage '" + s.name + "' is a '" + p.kind +
                            "' stage: it runs on one MPI rank (only engine and crush stages are "
                            "split over ranks): ranks = 1 or leave it out");
-    p.ranks = s.ranks > 0 ? s.ranks : time_loop_kind(p.kind) ? ranks : 1;
+    p.ranks = s.ranks > 0 ? s.ranks : is_time_loop_kind(p.kind) ? ranks : 1;
     hash_stage(p, hashes);
     hashes[s.name] = p.hash;
     plans.push_back(std::move(p));
