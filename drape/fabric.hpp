@@ -20,6 +20,10 @@ struct FabricSpec {
   double stitch_direction_deg = 0;           // wale (machine) direction to x; ply angles are to x too
   double stitch_gauge = 0;                   // m between wales (across x); 0: tow pitch * sqrt(2)
   double stitch_length = 0;                  // m between penetrations along a wale; 0: as the gauge
+  // m: penetrations closer to the blanket's edge are left out; < 0: half a lattice cell (its
+  // projection on x and y), which keeps every stitch inside a blanket; a small margin keeps the
+  // stitch density of the fabric in a small cell (picture frame)
+  double stitch_edge_margin = -1;
   // Mesh resolution of a tow.
   int elements_across_tow = 2;
   int elements_through_thickness = 1;

@@ -158,7 +158,11 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   const int reach_i = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / s)) + 1;
   const int reach_j = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / g)) + 1;
   const int i0 = -reach_i, j0 = -reach_j, ni = 2 * reach_i + nx, nj = 2 * reach_j + ny;
-  const double mx = 0.5 * (s * std::abs(mdir[0]) + g * std::abs(ndir[0])), my = 0.5 * (s * std::abs(mdir[1]) + g * std::abs(ndir[1]));
+  const bool own_margin = f.stitch_edge_margin >= 0;
+  const double mx =
+      own_margin ? f.stitch_edge_margin : 0.5 * (s * std::abs(mdir[0]) + g * std::abs(ndir[0]));
+  const double my =
+      own_margin ? f.stitch_edge_margin : 0.5 * (s * std::abs(mdir[1]) + g * std::abs(ndir[1]));
   // level[k][j * ni + i]: stitch node on ply boundary k (0: bottom face), -1 where none.
   std::vector<std::vector<std::int32_t>> level(
       n_levels, std::vector<std::int32_t>(static_cast<std::size_t>(ni * nj), -1));
@@ -179,6 +183,20 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       ++fm.n_penetrations;
     }
   if (fm.n_penetrations == 0) throw InputError(file, size_key, "the blanket holds no stitch penetration");
+  for (int jj = 0; jj < nj; ++jj)
+    for (int ii = 0; ii < ni; ++ii) {
+      if (level[0][static_cast<std::size_t>(jj * ni + ii)] < 0) continue;
+      bool outline = false;
+      for (int dj = -1; dj <= 1 && !outline; ++dj)
+        for (int di = -1; di <= 1 && !outline; ++di) {
+          const int i2 = ii + di, j2 = jj + dj;
+          outline = i2 < 0 || j2 < 0 || i2 >= ni || j2 >= nj ||
+                    level[0][static_cast<std::size_t>(j2 * ni + i2)] < 0;
+        }
+      if (outline)
+        for (std::size_t k = 0; k < n_levels; ++k)
+          fm.stitch_end_pins.push_back(level[k][static_cast<std::size_t>(jj * ni + ii)]);
+    }
   fm.stitch_I_part = mesh.add_part(prefix + "stitch_I");
   fm.stitch_leg_part = mesh.add_part(prefix + "stitch_legs");
   const bool tricot = f.stitch == StitchPattern::Tricot;

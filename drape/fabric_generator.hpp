@@ -43,6 +43,11 @@ struct FabricModel {
   /// tow end may rotate (a picture frame holds tows by these). Centred for an even
   /// elements_across_tow.
   std::vector<std::int32_t> tow_end_pins;
+  /// The stitch nodes (all ply boundaries) of the penetrations on the outline of the stitch
+  /// lattice (one of their eight lattice neighbours lies outside the blanket): where every stitch
+  /// line of the blanket ends. A picture frame that holds them (`anchored_nodes`) makes its cell
+  /// the interior of a large specimen, whose stitch is held by the fabric around (issue #19).
+  std::vector<std::int32_t> stitch_end_pins;
   std::size_t n_tows = 0, n_dropped_tows = 0;
   std::size_t n_penetrations = 0;
   double tow_thickness = 0;

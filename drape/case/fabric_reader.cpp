@@ -61,6 +61,8 @@ FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution
   f.stitch_direction_deg = fb.number("stitch_direction_deg", 0.0, {});
   f.stitch_gauge = fb.number("stitch_gauge", 0.0, {});
   f.stitch_length = fb.number("stitch_length", 0.0, {});
+  if (fb.has("stitch_edge_margin"))
+    f.stitch_edge_margin = fb.number("stitch_edge_margin", Range::non_negative());
   f.elements_across_tow = read_int(fb, "elements_across_tow", 2);
   f.elements_through_thickness = read_int(fb, "elements_through_thickness", 1);
   f.element_length = fb.number("element_length", 0.0, {});
@@ -257,13 +259,17 @@ void renumber_fabrics(fem::CaseReadContext& ctx, std::vector<FabricEntry>& fabri
                       const std::vector<std::int32_t>& new_of_old) {
   auto& pins = ctx.node_sets["tow_end_pins"];
   pins.owner = "[[mesh.fabric]]";
+  auto& stitch_pins = ctx.node_sets["stitch_end_pins"];
+  stitch_pins.owner = "[[mesh.fabric]]";
   for (auto& fe : fabrics) {
     for (auto& c : fe.model.connections)
       for (std::int32_t* nd : {&c.stitch_node, &c.tow_node, &c.tow_axis_node})
         *nd = new_of_old[static_cast<std::size_t>(*nd)];
     for (auto& nd : fe.model.stitch_nodes) nd = new_of_old[static_cast<std::size_t>(nd)];
     for (auto& nd : fe.model.tow_end_pins) nd = new_of_old[static_cast<std::size_t>(nd)];
+    for (auto& nd : fe.model.stitch_end_pins) nd = new_of_old[static_cast<std::size_t>(nd)];
     pins.sets[fe.name] = fe.model.tow_end_pins;
+    stitch_pins.sets[fe.name] = fe.model.stitch_end_pins;
   }
 }
 

@@ -1,4 +1,5 @@
 // [boundary], [load], [damping], [initial], [time].
+#include <algorithm>
 #include <cmath>
 
 #include "fem/case/fem_case.hpp"
@@ -41,6 +42,12 @@ void read_picture_frame(CaseReadContext& ctx, const TableReader& t) {
   PictureFrame pf;
   pf.name = t.string("name");
   pf.nodes = select_nodes(ctx, t, "nodes");
+  if (t.has("anchored_nodes")) {  // held as `nodes` too (a union): e.g. the stitch lines' ends
+    std::vector<std::int32_t> more = select_nodes(ctx, t, "anchored_nodes");
+    pf.nodes.insert(pf.nodes.end(), more.begin(), more.end());
+    std::sort(pf.nodes.begin(), pf.nodes.end());
+    pf.nodes.erase(std::unique(pf.nodes.begin(), pf.nodes.end()), pf.nodes.end());
+  }
   pf.corner = V3::from(t.vec3("corner"));
   V3 a1 = V3::from(t.vec3_or("arm1", {1, 0, 0})), a2 = V3::from(t.vec3_or("arm2", {0, 1, 0}));
   if (!(norm(a1) > 0) || !(norm(a2) > 0)) t.fail("arm1", "arms must not be zero");

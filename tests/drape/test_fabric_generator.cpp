@@ -227,3 +227,55 @@ TEST(FabricGenerator, RotatedStitchLattice) {
     }
   }
 }
+
+// The picture-frame cell (13.28 mm, wales at 45 deg to its sides): with the default margin half a
+// lattice cell (3.32 mm here) keeps 4 penetrations, a quarter of the cell's share of the fabric's
+// stitch (area / (s g) = 8); with stitch_edge_margin = 0 the penetrations on the sides are kept
+// too, and counting each as the share of it inside the cell (1 inside, 1/2 on a side, 1/4 at a
+// corner) gives the fabric's density. Every one of them lies on the outline of the lattice there,
+// so stitch_end_pins holds them all; on a larger blanket the pins are exactly the penetrations
+// with a missing lattice neighbour, every level of them.
+TEST(FabricGenerator, EdgeMarginKeepsTheStitchDensityOfASmallCellAndEndPinsAreItsOutline) {
+  drape::FabricSpec f;
+  f.ply_angles_deg = {0.0, 90.0};
+  f.stitch_direction_deg = 45.0;
+  const double L = 4 * f.tow_pitch();  // 13.28 mm
+  const auto loose = build(f, L, L);
+  EXPECT_EQ(loose.fm.n_penetrations, 4u);
+  f.stitch_edge_margin = 0;
+  const auto b = build(f, L, L);
+  EXPECT_EQ(b.fm.n_penetrations, 12u);
+  double share = 0;
+  const double tol = 1e-9;
+  for (std::size_t k = 0; k < b.fm.stitch_nodes.size(); k += 3) {  // one per penetration (3 levels)
+    const auto nd = static_cast<std::size_t>(b.fm.stitch_nodes[k]);
+    const double x = b.mesh.coords[3 * nd], y = b.mesh.coords[3 * nd + 1];
+    const bool on_x = std::abs(x) < tol || std::abs(x - L) < tol,
+               on_y = std::abs(y) < tol || std::abs(y - L) < tol;
+    share += on_x && on_y ? 0.25 : on_x || on_y ? 0.5 : 1.0;
+  }
+  EXPECT_NEAR(share, L * L / (f.penetration_spacing() * f.gauge()), 1e-9);
+  EXPECT_EQ(b.fm.stitch_end_pins.size(), b.fm.stitch_nodes.size());
+
+  // A 40 x 40 mm blanket, wales along x: the lattice is an nx x ny grid whose outline is its first
+  // and last row and column.
+  drape::FabricSpec g;
+  const auto big = build(g, 0.04, 0.04);
+  const int nx = static_cast<int>(std::floor(0.04 / g.penetration_spacing()));
+  const int ny = static_cast<int>(std::floor(0.04 / g.gauge()));
+  ASSERT_EQ(big.fm.n_penetrations, static_cast<std::size_t>(nx * ny));
+  EXPECT_EQ(big.fm.stitch_end_pins.size(), static_cast<std::size_t>(3 * (2 * nx + 2 * ny - 4)));
+  const std::set<std::int32_t> pins(big.fm.stitch_end_pins.begin(), big.fm.stitch_end_pins.end());
+  double xmin = 1, xmax = -1, ymin = 1, ymax = -1;
+  for (auto nd : big.fm.stitch_nodes) {
+    xmin = std::min(xmin, big.mesh.coords[3 * nd]), xmax = std::max(xmax, big.mesh.coords[3 * nd]);
+    ymin = std::min(ymin, big.mesh.coords[3 * nd + 1]),
+    ymax = std::max(ymax, big.mesh.coords[3 * nd + 1]);
+  }
+  for (auto nd : big.fm.stitch_nodes) {
+    const double x = big.mesh.coords[3 * nd], y = big.mesh.coords[3 * nd + 1];
+    const bool edge = std::abs(x - xmin) < tol || std::abs(x - xmax) < tol ||
+                      std::abs(y - ymin) < tol || std::abs(y - ymax) < tol;
+    EXPECT_EQ(pins.count(nd) == 1, edge) << "stitch node at (" << x << ", " << y << ")";
+  }
+}
