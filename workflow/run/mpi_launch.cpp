@@ -37,7 +37,8 @@ std::vector<std::string> launcher_environment() {
     const std::string name = item.substr(0, item.find('='));
     const bool ours = name == "OMPI_ALLOW_RUN_AS_ROOT" ||
                       name == "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM" ||
-                      name == "OMPI_MCA_rmaps_base_oversubscribe";
+                      name == "OMPI_MCA_rmaps_base_oversubscribe" ||
+                      name == "OMPI_MCA_orte_execute_quiet";
     if (set_by_mpi(name) && !ours && !g_startup_names.count(name)) continue;
     env.push_back(item);
   }
@@ -56,6 +57,9 @@ std::vector<std::string> mpi_launch_command(int ranks) {
   ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
   ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
   // Oversubscribed, Open MPI yields the core while it waits (slower messages): only then.
+  // A run's stop (Ctrl-C, time.max_cycles: exit 1, results valid) is not a job failure: without
+  // this Open MPI adds its "job has been aborted" banner to ncfsim's own message.
+  ::setenv("OMPI_MCA_orte_execute_quiet", "1", 0);
   if (static_cast<unsigned>(ranks) > std::thread::hardware_concurrency())
     ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
   return {mpi_launcher(), "-n", std::to_string(ranks), self_executable()};
