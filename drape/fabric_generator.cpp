@@ -29,6 +29,27 @@ bool clip_line(const std::array<double, 2>& p0, const std::array<double, 2>& a, 
   return t1 > t0;
 }
 
+// The nodes (every level) of the lattice points present in level[0] (an ni x nj lattice, -1 where
+// none) with one of their eight neighbours missing: the lattice's outline.
+std::vector<std::int32_t> lattice_outline_nodes(const std::vector<std::vector<std::int32_t>>& level,
+                                                int ni, int nj) {
+  const auto at = [&](int i, int j) { return level[0][static_cast<std::size_t>(j * ni + i)]; };
+  std::vector<std::int32_t> out;
+  for (int j = 0; j < nj; ++j)
+    for (int i = 0; i < ni; ++i) {
+      if (at(i, j) < 0) continue;
+      bool outline = false;
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          const int i2 = i + di, j2 = j + dj;
+          outline = outline || i2 < 0 || j2 < 0 || i2 >= ni || j2 >= nj || at(i2, j2) < 0;
+        }
+      if (outline)
+        for (const auto& lv : level) out.push_back(lv[static_cast<std::size_t>(j * ni + i)]);
+    }
+  return out;
+}
+
 }  // namespace
 
 FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl, const std::string& file,
@@ -183,20 +204,7 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       ++fm.n_penetrations;
     }
   if (fm.n_penetrations == 0) throw InputError(file, size_key, "the blanket holds no stitch penetration");
-  for (int jj = 0; jj < nj; ++jj)
-    for (int ii = 0; ii < ni; ++ii) {
-      if (level[0][static_cast<std::size_t>(jj * ni + ii)] < 0) continue;
-      bool outline = false;
-      for (int dj = -1; dj <= 1 && !outline; ++dj)
-        for (int di = -1; di <= 1 && !outline; ++di) {
-          const int i2 = ii + di, j2 = jj + dj;
-          outline = i2 < 0 || j2 < 0 || i2 >= ni || j2 >= nj ||
-                    level[0][static_cast<std::size_t>(j2 * ni + i2)] < 0;
-        }
-      if (outline)
-        for (std::size_t k = 0; k < n_levels; ++k)
-          fm.stitch_end_pins.push_back(level[k][static_cast<std::size_t>(jj * ni + ii)]);
-    }
+  fm.stitch_end_pins = lattice_outline_nodes(level, ni, nj);
   fm.stitch_I_part = mesh.add_part(prefix + "stitch_I");
   fm.stitch_leg_part = mesh.add_part(prefix + "stitch_legs");
   const bool tricot = f.stitch == StitchPattern::Tricot;

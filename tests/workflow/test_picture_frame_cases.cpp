@@ -16,15 +16,15 @@
 //   below; the 'Lambda' underlaps run along a fibre direction and do not stretch in either sign).
 // The bounds and the measured references are read from cases/drape/reference/picture_frame_*.csv.
 #include <gtest/gtest.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "tests/workflow/cli_test_support.hpp"
 
@@ -88,16 +88,29 @@ std::pair<double, double> fit(const FrameRun& r, double a, double b) {
   return {(sf - c1 * sg) / n, c1};
 }
 
+// The positive case's tabulated 'I' pillar law ([[bar_law]] "stitch_I"): strain, force (N).
+std::pair<std::vector<double>, std::vector<double>> pillar_law() {
+  const toml::table root =
+      toml::parse_file((kSource / "cases/drape/picture_frame_positive.toml").string());
+  std::vector<double> strain, force;
+  for (const auto& node : *root["bar_law"].as_array()) {
+    const toml::table& law = *node.as_table();
+    if (law["name"].value_or(std::string()) != "stitch_I") continue;
+    for (const auto& v : *law["strain"].as_array()) strain.push_back(v.value_or(NAN));
+    for (const auto& v : *law["force"].as_array()) force.push_back(v.value_or(NAN));
+  }
+  EXPECT_GE(strain.size(), 2u) << "no stitch_I bar_law in picture_frame_positive.toml";
+  return {strain, force};
+}
+
 // Normalised shear force (N/m) of the 'I' pillar stitches when they follow the frame exactly: the
 // wale lies along the diagonal that opens, so a pillar stretches by e = sqrt(2) cos(45 deg - g/2) -
-// 1 (paper Eq. 4-5) and carries T(e) (the case's tabulated stitch_I law); pillars lie a gauge G
-// apart, so their power per unit initial area is T(e) de/dg dg/dt / G, and the frame's normalised
-// force is that power per unit area over cos(g) dg/dt (the power of F_sh L cos g dg/dt on an area
-// L^2 cos g).
+// 1 (paper Eq. 4-5) and carries T(e) (the case's tabulated stitch_I law, linear between its
+// points); pillars lie a gauge G apart, so their power per unit initial area is T(e) de/dg dg/dt /
+// G, and the frame's normalised force is that power per unit area over cos(g) dg/dt (the power of
+// F_sh L cos g dg/dt on an area L^2 cos g).
 double pillar_stitch_force(double g_deg) {
-  const std::vector<double> strain{0.0,  0.02, 0.05,
-                                   0.10, 0.20, 0.40};                // picture_frame_positive.toml
-  const std::vector<double> force{0.0, 0.20, 0.80, 2.0, 5.0, 12.0};  // N
+  static const auto [strain, force] = pillar_law();
   const double gauge = 3.32e-3 * std::sqrt(2.0);  // m: tow pitch (3.22 + 0.10 mm) times sqrt(2)
   const double g = g_deg * M_PI / 180, e = std::sqrt(2.0) * std::cos(M_PI / 4 - g / 2) - 1;
   std::size_t k = 1;
