@@ -95,10 +95,12 @@ NodeUpdateSums owned_node_update(NodeUpdate f,
 }
 
 // The step of the next cycle, the smallest over the ranks, and the controlling element (the
-// smallest element step; ties to the lower user id, as on one rank within a group).
-void reduce_step(MPI_Comm comm, double& dt_new, StableStep& st) {
+// smallest element step; ties to the lower user id, as on one rank within a group); returns the
+// lowest rank that reports a blow-up (`blow_up_rank`: this rank's number if it does, else the
+// number of ranks), so that a blow-up costs no collective of its own.
+int reduce_step(MPI_Comm comm, double& dt_new, StableStep& st, int blow_up_rank) {
   struct Packed {
-    double dt_new, dt, element, kind;
+    double dt_new, dt, element, kind, blow_up_rank;
   };
   static MPI_Op op = [] {
     MPI_Op o;
@@ -110,6 +112,7 @@ void reduce_step(MPI_Comm comm, double& dt_new, StableStep& st) {
             b[i].dt_new = std::min(a[i].dt_new, b[i].dt_new);
             if (a[i].dt < b[i].dt || (a[i].dt == b[i].dt && a[i].element < b[i].element))
               b[i].dt = a[i].dt, b[i].element = a[i].element, b[i].kind = a[i].kind;
+            b[i].blow_up_rank = std::min(a[i].blow_up_rank, b[i].blow_up_rank);
           }
         },
         1, &o);
@@ -117,16 +120,18 @@ void reduce_step(MPI_Comm comm, double& dt_new, StableStep& st) {
   }();
   static MPI_Datatype type = [] {
     MPI_Datatype t;
-    MPI_Type_contiguous(4, MPI_DOUBLE, &t);
+    MPI_Type_contiguous(5, MPI_DOUBLE, &t);
     MPI_Type_commit(&t);
     return t;
   }();
-  Packed p{dt_new, st.dt, static_cast<double>(st.element), static_cast<double>(st.kind)};
+  Packed p{dt_new, st.dt, static_cast<double>(st.element), static_cast<double>(st.kind),
+           static_cast<double>(blow_up_rank)};
   MPI_Allreduce(MPI_IN_PLACE, &p, 1, type, op, comm);
   dt_new = p.dt_new;
   st.dt = p.dt;
   st.element = static_cast<std::int64_t>(p.element);
   st.kind = static_cast<ElementKind>(static_cast<int>(p.kind));
+  return static_cast<int>(p.blow_up_rank);
 }
 
 }  // namespace
@@ -508,12 +513,14 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
   return "(unknown position)";
 }
 
-void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bool check_steps) {
+void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bool check_steps,
+                           const std::string& blow_up) {
   const double sf = model_.time.safety_factor;
   std::vector<std::int32_t> gone;  // mesh-wide element indices
   std::vector<std::int32_t> orphans;
   std::vector<std::size_t> failed;
-  for (std::size_t k = 0; k < groups_.size(); ++k) {
+  // A rank whose kernels blew up only takes part in the sharing below, which tells the others.
+  for (std::size_t k = 0; k < groups_.size() && blow_up.empty(); ++k) {
     ElementGroup& g = *groups_[k];
     if (!g.can_erode()) continue;
     failed.clear();
@@ -561,7 +568,7 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bo
     }
     group_step_[k] = left;
   }
-  if (domain_) share_erosions(gone, orphans);
+  if (domain_) share_erosions(gone, orphans, blow_up);
   if (!gone.empty())
     for (auto& c : model_.contacts) c->erode(gone);
   if (!orphans.empty()) free_orphan_nodes(orphans);
@@ -571,7 +578,8 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bo
 // rank would have eroded them: group, then element), takes them out of its copies of the groups,
 // contacts and node counts, and lists the events; each rank has booked the energies of its own.
 void ExplicitSolver::share_erosions(std::vector<std::int32_t>& gone,
-                                    std::vector<std::int32_t>& orphans) {
+                                    std::vector<std::int32_t>& orphans,
+                                    const std::string& blow_up) {
   constexpr int kFields = 12;
   const std::size_t n_mine = local_erosions_.size();
   std::vector<double> mine;
@@ -588,7 +596,17 @@ void ExplicitSolver::share_erosions(std::vector<std::int32_t>& gone,
   const int p = domain_->size();
   std::vector<int> counts(static_cast<std::size_t>(p)), displs(static_cast<std::size_t>(p));
   int n = static_cast<int>(mine.size());
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, domain_->comm());
+  // With each rank's count goes whether its kernels blew up: the report needs no collective
+  // of its own.
+  std::vector<int> sent(2 * static_cast<std::size_t>(p));
+  const std::array<int, 2> pair{n, blow_up.empty() ? 0 : 1};
+  MPI_Allgather(pair.data(), 2, MPI_INT, sent.data(), 2, MPI_INT, domain_->comm());
+  int from = p;
+  for (int r = p - 1; r >= 0; --r) {
+    counts[static_cast<std::size_t>(r)] = sent[2 * static_cast<std::size_t>(r)];
+    if (sent[2 * static_cast<std::size_t>(r) + 1]) from = r;
+  }
+  throw_blow_up_of(from, blow_up);
   int total = 0;
   for (int r = 0; r < p; ++r)
     displs[static_cast<std::size_t>(r)] = total, total += counts[static_cast<std::size_t>(r)];
@@ -709,7 +727,11 @@ void ExplicitSolver::check_finite(const double* vel) const {
 void ExplicitSolver::share_blow_up(const std::string& what) const {
   int from = what.empty() || what == "-" ? domain_->size() : domain_->rank();
   MPI_Allreduce(MPI_IN_PLACE, &from, 1, MPI_INT, MPI_MIN, domain_->comm());
-  if (from == domain_->size()) return;  // no rank has one
+  throw_blow_up_of(from, what);
+}
+
+void ExplicitSolver::throw_blow_up_of(int from, const std::string& what) const {
+  if (from >= domain_->size()) return;  // no rank has one
   std::string msg = what;
   int len = static_cast<int>(msg.size());
   MPI_Bcast(&len, 1, MPI_INT, from, domain_->comm());
@@ -781,17 +803,17 @@ void ExplicitSolver::internal_forces(const CycleArrays& a, Cycle& c) {
   c.booked0 = {energy_.internal, energy_.eroded_internal, energy_.eroded_kinetic};
   eroded_any_ = false;
   const ElementCycleState cs{a.x, a.v, a.x0, dt_prev_};
-  std::string blow_up;  // several ranks: a kernel's blow-up report, shared below
-  for (std::size_t k = 0; k < groups_.size() && blow_up.empty(); ++k) {
+  // Several ranks: a kernel's blow-up report is told to all at the next collective (the erosion
+  // count or the step); this rank skips the rest of the cycle's work until then.
+  for (std::size_t k = 0; k < groups_.size() && c.blow_up.empty(); ++k) {
     group_step_[k] = StableStep{};
     try {
       groups_[k]->internal_forces(cs, a.fi, c.inc, group_step_[k]);
     } catch (const NumericalError& e) {
       if (!domain_) throw;
-      blow_up = e.what();
+      c.blow_up = e.what();
     }
   }
-  if (domain_) share_blow_up(blow_up);
 }
 
 // Erosion, then the next step from the elements left (this rank's; exchange_forces takes the
@@ -810,7 +832,7 @@ void ExplicitSolver::erode_and_choose_step(const CycleArrays& a, Cycle& c) {
       check_steps =
           model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0;
     }
-    erode(a.x, a.v, dt_erode, check_steps);
+    erode(a.x, a.v, dt_erode, check_steps, c.blow_up);
   }
   for (const auto& s : group_step_) take_smaller(c.st, s);
   if (!domain_) {  // on several ranks they are summed over the ranks with the works
@@ -827,20 +849,28 @@ void ExplicitSolver::erode_and_choose_step(const CycleArrays& a, Cycle& c) {
 
 // Contact forces at x^n: rigid tools, contacts (which may lower the step), rigs' walls.
 void ExplicitSolver::contact_forces(const CycleArrays& a, Cycle& c) {
+  if (!c.blow_up.empty()) return;  // several ranks: stopping at the step's reduction
   const double dt_c = dt_prev_ > 0 ? dt_prev_ : c.dt_new;
-  for (auto& tool : model_.tools) tool_contact_forces(tool, a.x, a.v, a.m, dt_c, a.fc);
-  for (auto& k : model_.contacts) {
-    k->add_forces(a.x, a.v, a.m, dt_c, a.fc);
-    c.dt_new = std::min(c.dt_new, k->stable_step_limit());
+  try {
+    for (auto& tool : model_.tools) tool_contact_forces(tool, a.x, a.v, a.m, dt_c, a.fc);
+    for (auto& k : model_.contacts) {
+      k->add_forces(a.x, a.v, a.m, dt_c, a.fc);
+      c.dt_new = std::min(c.dt_new, k->stable_step_limit());
+    }
+    for (auto& m : motions_)
+      if (m->has_forces()) m->add_forces(t_, a.x, a.m, dt_c, a.fc);
+  } catch (const NumericalError& e) {
+    // Several ranks: the others would wait for this one at the step's reduction; tell them there.
+    if (!domain_) throw;
+    c.blow_up = e.what();
   }
-  for (auto& m : motions_)
-    if (m->has_forces()) m->add_forces(t_, a.x, a.m, dt_c, a.fc);
 }
 
 // Several ranks: the smallest step of all ranks (its element named as on one rank) and every
 // node's whole force on its owner.
 void ExplicitSolver::exchange_forces(const CycleArrays& a, Cycle& c) {
-  reduce_step(domain_->comm(), c.dt_new, c.st);
+  const int me = c.blow_up.empty() ? domain_->size() : domain_->rank();
+  throw_blow_up_of(reduce_step(domain_->comm(), c.dt_new, c.st, me), c.blow_up);
   step_ = c.st;
   domain_->add_ghosts_to_owners(a.fi, c.has_contact ? a.fc : nullptr);
 }
@@ -1007,8 +1037,14 @@ void ExplicitSolver::sum_over_ranks(Cycle& c) {
       m->add_force_work(t_ - 0.5 * dt_prev_, c.t_half, dt_prev_, c.dt_new, mw[0], mw[1], mw[2],
                         mw[3]);
   if (has_motion_forces_) r.insert(r.end(), mw.begin(), mw.end());
+  // The loop's requests (raise_requests), one count per flag: 0 where no rank raised it.
+  const std::size_t at_requests = r.size();
+  for (unsigned b = 0; (kRequestMask >> b) != 0; ++b) r.push_back((requests_ >> b) & 1u);
   MPI_Allreduce(MPI_IN_PLACE, r.data(), static_cast<int>(r.size()), MPI_DOUBLE, MPI_SUM,
                 domain_->comm());
+  requests_all_ranks_ = 0;
+  for (unsigned b = 0; (kRequestMask >> b) != 0; ++b)
+    if (r[at_requests + b] > 0) requests_all_ranks_ |= 1u << b;
   c.ext_old = r[0], c.ext_new = r[1], c.damp_old = r[2], c.damp_new = r[3], c.con_old = r[4],
   c.con_new = r[5], c.ke = r[6];
   energy_.internal = booked0[0] + r[11] + r[7];
@@ -1020,7 +1056,9 @@ void ExplicitSolver::sum_over_ranks(Cycle& c) {
   friction_all_ranks_ = r[14];
   for (std::size_t k = 0; k < model_.tools.size(); ++k)
     model_.tools[k].force = {r[15 + 3 * k], r[16 + 3 * k], r[17 + 3 * k]};
-  if (has_motion_forces_) std::copy(r.end() - 4, r.end(), motion_work_all_ranks_.begin());
+  if (has_motion_forces_)
+    std::copy(r.begin() + static_cast<std::ptrdiff_t>(at_requests) - 4,
+              r.begin() + static_cast<std::ptrdiff_t>(at_requests), motion_work_all_ranks_.begin());
   timers_.exchange += seconds_since(tr);
 }
 

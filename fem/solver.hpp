@@ -106,6 +106,12 @@ class ExplicitSolver {
   const PhaseTimers& timers() const { return timers_; }
   /// The split over MPI ranks (fem/parallel/domain.hpp); null on one rank.
   const Domain* domain() const { return domain_.get(); }
+  /// Several ranks: flags (bits 0-3) the caller's loop raises on this rank (a stop, a
+  /// checkpoint), OR-ed over the ranks in the next cycle's sums rather than in a collective of
+  /// their own; requests_all_ranks() gives that OR after the cycle (0 before the first).
+  void raise_requests(unsigned flags) { requests_ = flags & kRequestMask; }
+  unsigned requests_all_ranks() const { return requests_all_ranks_; }
+  static constexpr unsigned kRequestMask = 0xF;
   /// On several ranks: brings the whole state to the root (nodal arrays, element state, tool
   /// counters) so that output code reads it there as on one rank. Collective; nothing on one rank.
   void gather_for_output();
@@ -171,6 +177,9 @@ class ExplicitSolver {
     // Works over the increments around t^n (F.du_old, F.du_new per force kind) and the kinetic
     // energy in product form: this rank's share until sum_over_ranks.
     double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
+    // Several ranks: this rank's report of a blow-up in its kernels or contacts, told to all at
+    // the cycle's next collective (no collective of its own: one sync point less per cycle).
+    std::string blow_up;
   };
   /// The nodal arrays of a cycle ([3*n_nodes]; step() holds the vectors' views).
   struct CycleArrays {
@@ -198,15 +207,20 @@ class ExplicitSolver {
   /// Several ranks (collective): throws on every rank the NumericalError `what` of the lowest
   /// rank whose `what` is a report (not empty, not "-"); returns when no rank has one.
   void share_blow_up(const std::string& what) const;
+  /// Several ranks (collective): throws on every rank the report `what` of rank `from`, which the
+  /// ranks found together in a reduction (`from` = size: none, returns).
+  void throw_blow_up_of(int from, const std::string& what) const;
   void build_motions();
   /// Erodes every element of the groups that can lose elements whose step at x (times the
   /// safety factor) is below dt_erode or one of whose corners has folded over (corner Jacobian
   /// <= 0); those groups' steps (group_step_) become the stable step of the elements left.
   /// Without `check_steps` only the elements the material has failed are eroded.
   /// Nodes of eroded elements left with no element are taken out (see n_freed_nodes).
-  void erode(const double* x, const double* v, double dt_erode, bool check_steps);
+  void erode(const double* x, const double* v, double dt_erode, bool check_steps,
+             const std::string& blow_up = {});
   /// Several ranks: shares this cycle's erosions (see solver.cpp); `gone` becomes every rank's.
-  void share_erosions(std::vector<std::int32_t>& gone, std::vector<std::int32_t>& orphans);
+  void share_erosions(std::vector<std::int32_t>& gone, std::vector<std::int32_t>& orphans,
+                      const std::string& blow_up);
   /// Takes out the nodes of `candidates` that no element holds any more and no constraint drives.
   void free_orphan_nodes(const std::vector<std::int32_t>& candidates);
   /// "(x, y, z) m": centroid at x of the element a StableStep names (for messages).
@@ -236,6 +250,7 @@ class ExplicitSolver {
   std::vector<std::pair<std::size_t, std::size_t>> local_erosions_;  // (group, element) this cycle
   bool eroded_any_ = false;        // several ranks: some rank eroded an element this cycle
   double friction_all_ranks_ = 0;  // several ranks: friction dissipated, summed this cycle
+  unsigned requests_ = 0, requests_all_ranks_ = 0;  // several ranks: see raise_requests
   std::vector<std::vector<ContactResultant>> contact_resultants_;  // several ranks: summed
   std::vector<double> contact_max_penetration_;
   std::array<double, 4> motion_work_all_ranks_{};  // several ranks: the rigs' wall works, summed

@@ -186,6 +186,32 @@ TEST(MpiRuns, WhatCannotBeSplitIsRefused) {
 // A contact halo too small for the sliding (here for the mesh itself: 2 mm against tow elements
 // of about that size): an owned node reaches the edge of the segments its rank reads, and the run
 // stops with exit 3 naming the contact, the node and the key, instead of missing contacts.
+// A blow-up that only one rank sees (a kicked corner node turns its hexahedron inside out in the
+// first cycle; 2 ranks split the block) reaches the others at the cycle's next collective (the
+// step's reduction, or the erosion count when erosion is on): every rank stops, the run exits 3
+// with the kernel's report naming the element and its position, as on one rank.
+TEST(MpiRuns, BlowUpOnOneRankStopsEveryRankWithItsReport) {
+  if (!launcher_works()) GTEST_SKIP() << "the MPI launcher does not start here";
+  const std::string what =
+      "hexahedron 128 (part 0) has a non-positive volume -5.38932e-08 m^3 at (0.00875, "
+      "0.00875, 0.0131539) m";
+  for (const char* erosion : {"0", "0.5"}) {
+    for (const char* np : {"1", "2"}) {
+      SCOPED_TRACE(std::string("--np ") + np + ", erosion_step_ratio " + erosion);
+      const fs::path out = fresh_dir(std::string("mpi_blow_up_") + np + "_" + erosion);
+      const Result r = run_cli(
+          {"-q", "run", (kSource / "tests/cases/mpi/kicked_corner.toml").string(), "-o",
+           out.string(), "--np", np, "--set", std::string("time.erosion_step_ratio=") + erosion});
+      EXPECT_EQ(r.code, 3) << r.output;
+      EXPECT_NE(r.output.find(what), std::string::npos) << r.output;
+      const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+      EXPECT_EQ(s["status"], "numerical_failure");
+      EXPECT_EQ(s["error"], what);
+      fs::remove_all(out);
+    }
+  }
+}
+
 TEST(MpiRuns, ContactReachingTheEdgeOfTheHaloStopsTheRun) {
   if (!launcher_works()) GTEST_SKIP() << "the MPI launcher does not start here";
   const fs::path out = fresh_dir("mpi_halo_edge");

@@ -470,14 +470,22 @@ void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size
 
 // What the top of a cycle asks of every rank at once: stop (Ctrl-C on any rank: a rank that
 // stopped alone would leave the others waiting in the next exchange) and a checkpoint (the
-// root's wall-time interval has passed).
+// root's wall-time interval has passed). On several ranks the flags travel with the cycle's sums
+// (ExplicitSolver::raise_requests: no collective of their own): a rank raises its flags for the
+// next cycle (post_requests) and all ranks act on what was raised one cycle later, together.
 struct LoopRequests {
   bool stop = false, checkpoint = false;
 };
-LoopRequests loop_requests(const fem::ExplicitSolver& s, bool checkpoint_due) {
-  int flags = (StopRequest::requested() ? 1 : 0) | (checkpoint_due ? 2 : 0);
-  if (s.domain()) MPI_Allreduce(MPI_IN_PLACE, &flags, 1, MPI_INT, MPI_BOR, s.domain()->comm());
-  return {(flags & 1) != 0, (flags & 2) != 0};
+unsigned local_requests(bool checkpoint_due) {
+  return (StopRequest::requested() ? 1u : 0u) | (checkpoint_due ? 2u : 0u);
+}
+LoopRequests pending_requests(const fem::ExplicitSolver& s, bool checkpoint_due) {
+  const unsigned flags = s.domain() ? s.requests_all_ranks() : local_requests(checkpoint_due);
+  return {(flags & 1u) != 0, (flags & 2u) != 0};
+}
+// After the requests were handled: this rank's flags go with the next cycle's sums.
+void post_requests(fem::ExplicitSolver& s, bool checkpoint_due) {
+  if (s.domain()) s.raise_requests(local_requests(checkpoint_due));
 }
 
 bool checkpoint_every_cycles_due(const OutputSettings& out, const fem::ExplicitSolver& s) {
@@ -520,9 +528,11 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
         write_checkpoint(r, solver, measures, history, frames);
         break;
       }
-      const LoopRequests req = loop_requests(
-          solver, out.checkpoint_interval_min > 0 &&
-                      seconds_since(r.last_checkpoint) >= 60 * out.checkpoint_interval_min);
+      const auto checkpoint_due = [&] {
+        return out.checkpoint_interval_min > 0 &&
+               seconds_since(r.last_checkpoint) >= 60 * out.checkpoint_interval_min;
+      };
+      const LoopRequests req = pending_requests(solver, checkpoint_due());
       if (req.stop) {
         r.status = "interrupted";
         r.log->warn(
@@ -534,6 +544,7 @@ int time_loop(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHis
       }
       if (checkpoint_every_cycles_due(out, solver) || req.checkpoint)
         write_checkpoint(r, solver, measures, history, frames);
+      post_requests(solver, checkpoint_due());
       // Only a history row or a frame reads x^n in the callback: in the other cycles the
       // positions move in the solver's velocity pass (one sweep over the nodal arrays).
       const bool reads_x = output_due(solver.time(), r.loop);
@@ -703,13 +714,14 @@ int run_engine_worker(EngineCase& ec, const RunOptions& options) {
         write_rank_checkpoint(ck, solver, loop);
         break;
       }
-      const LoopRequests req = loop_requests(solver, false);
+      const LoopRequests req = pending_requests(solver, false);
       if (req.stop) {
         write_rank_checkpoint(ck, solver, loop);
         break;
       }
       if (checkpoint_every_cycles_due(out, solver) || req.checkpoint)
         write_rank_checkpoint(ck, solver, loop);
+      post_requests(solver, false);
       const auto at_tn = [&] {
         const double t = solver.time();
         if (!output_due(t, loop)) return;
