@@ -49,6 +49,10 @@ class ContactAlgorithm {
   virtual std::int64_t active_contacts() const { return 0; }
   /// Deepest penetration past the contact thickness over the run so far, m (0: not tracked).
   virtual double max_penetration() const { return 0; }
+  /// Cost counters for the run's log (0: not counted): the contact nodes searched and the
+  /// broad-phase searches (bucket sorts) made so far.
+  virtual std::size_t n_contact_nodes() const { return 0; }
+  virtual std::int64_t n_broad_phase_searches() const { return 0; }
   /// The elements `mesh_elements` (mesh-wide indices: Mesh::element_offset of the kind plus the
   /// index in its set) were eroded: their faces stop being contact segments from the next
   /// add_forces on, and the faces of their neighbours that they covered start being ones.

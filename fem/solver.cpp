@@ -285,10 +285,11 @@ void ExplicitSolver::decompose() {
     for (const auto& g : groups_) n_el += g->size();
     const int p = PetscSession::size();
     if (static_cast<std::size_t>(p) > most)
-      throw InputError("", "--np",
-                       std::to_string(p) + " MPI ranks for " + std::to_string(n_el) +
-                           " elements: the model splits into at most " + std::to_string(most) +
-                           " (one kernel chunk of 32 hexahedra or 256 bars per rank at least)");
+      throw InputError(
+          "", "--np",
+          std::to_string(p) + " MPI ranks for " + std::to_string(n_el) +
+              " elements: the model splits into at most " + std::to_string(most) +
+              " (one kernel chunk of 32 hexahedra, 64 shells or 256 bars per rank at least)");
   }
   {
     auto X0 = x0.view();
@@ -299,16 +300,18 @@ void ExplicitSolver::decompose() {
     for (std::size_t g = 0; g < groups_.size(); ++g)
       n_el += domain_->range(g, r).second - domain_->range(g, r).first;
     if (n_el == 0)
-      throw InputError("", "--np",
-                       "rank " + std::to_string(r) + " of " + std::to_string(domain_->size()) +
-                           " gets no element (the model's elements come in too few kernel "
-                           "chunks of 32 hexahedra or 256 bars for so many ranks): fewer ranks");
+      throw InputError(
+          "", "--np",
+          "rank " + std::to_string(r) + " of " + std::to_string(domain_->size()) +
+              " gets no element (the model's elements come in too few kernel "
+              "chunks of 32 hexahedra, 64 shells or 256 bars for so many ranks): fewer ranks");
   }
   for (std::size_t g = 0; g < groups_.size(); ++g) {
     const auto [b, e] = domain_->range(g);
     if (!groups_[g]->set_range(b, e))
       refuse("part." + model_.mesh.part_names[static_cast<std::size_t>(groups_[g]->part())],
              std::string("a part of ") + element_noun(groups_[g]->kind()) + " elements");
+    groups_[g]->set_owned_nodes(domain_->owned_mask().data());
   }
   // Each node meets each tool on the rank that owns it.
   for (auto& tool : model_.tools)
@@ -853,9 +856,13 @@ void ExplicitSolver::contact_forces(const CycleArrays& a, Cycle& c) {
   const double dt_c = dt_prev_ > 0 ? dt_prev_ : c.dt_new;
   try {
     for (auto& tool : model_.tools) tool_contact_forces(tool, a.x, a.v, a.m, dt_c, a.fc);
-    for (auto& k : model_.contacts) {
+    contact_seconds_.resize(model_.contacts.size(), 0.0);
+    for (std::size_t q = 0; q < model_.contacts.size(); ++q) {
+      const auto t0 = Clock::now();
+      auto& k = model_.contacts[q];
       k->add_forces(a.x, a.v, a.m, dt_c, a.fc);
       c.dt_new = std::min(c.dt_new, k->stable_step_limit());
+      contact_seconds_[q] += seconds_since(t0);
     }
     for (auto& m : motions_)
       if (m->has_forces()) m->add_forces(t_, a.x, a.m, dt_c, a.fc);
@@ -873,6 +880,12 @@ void ExplicitSolver::exchange_forces(const CycleArrays& a, Cycle& c) {
   throw_blow_up_of(reduce_step(domain_->comm(), c.dt_new, c.st, me), c.blow_up);
   step_ = c.st;
   domain_->add_ghosts_to_owners(a.fi, c.has_contact ? a.fc : nullptr);
+  // The shells' nodal moments: each node's whole moment on every rank that advances its rotation.
+  for (auto& g : groups_)
+    if (double* m = g->nodal_moments()) {
+      domain_->add_ghosts_to_owners(m, nullptr);
+      domain_->refresh_ghosts(m);
+    }
 }
 
 // External forces at t^n (loads, gravity); a step below time.min_step_ratio stops the run.

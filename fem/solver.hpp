@@ -104,6 +104,10 @@ class ExplicitSolver {
   /// contact, their kinetic energy booked as EnergyBalance::eroded_kinetic.
   std::size_t n_freed_nodes() const { return n_freed_nodes_; }
   const PhaseTimers& timers() const { return timers_; }
+  /// Seconds spent in contact k (model().contacts[k]) so far, part of timers().contact.
+  double contact_seconds(std::size_t k) const {
+    return k < contact_seconds_.size() ? contact_seconds_[k] : 0.0;
+  }
   /// The split over MPI ranks (fem/parallel/domain.hpp); null on one rank.
   const Domain* domain() const { return domain_.get(); }
   /// Several ranks: flags (bits 0-3) the caller's loop raises on this rank (a stop, a
@@ -251,6 +255,7 @@ class ExplicitSolver {
   bool eroded_any_ = false;        // several ranks: some rank eroded an element this cycle
   double friction_all_ranks_ = 0;  // several ranks: friction dissipated, summed this cycle
   unsigned requests_ = 0, requests_all_ranks_ = 0;  // several ranks: see raise_requests
+  std::vector<double> contact_seconds_;             // per contact, see contact_seconds
   std::vector<std::vector<ContactResultant>> contact_resultants_;  // several ranks: summed
   std::vector<double> contact_max_penetration_;
   std::array<double, 4> motion_work_all_ranks_{};  // several ranks: the rigs' wall works, summed

@@ -98,7 +98,8 @@ class PenaltyContact final : public ContactAlgorithm {
   const ContactSurface& surface() const { return surf_; }
   const PenaltyContactStats& stats() const { return stats_; }
   double search_margin() const { return margin_; }
-  std::size_t n_contact_nodes() const { return surf_.n_nodes(); }
+  std::size_t n_contact_nodes() const override { return surf_.n_nodes(); }
+  std::int64_t n_broad_phase_searches() const override { return stats_.n_sorts; }
 
  private:
   void sort_segments(const double* x);                      // broad phase at positions x

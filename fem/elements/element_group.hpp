@@ -72,6 +72,12 @@ class ElementGroup {
   /// The per-element state arrays, [components][size()] doubles each, that an output on the
   /// root gathers from the ranks that integrate them.
   virtual std::vector<std::pair<double*, int>> state_arrays() { return {}; }
+  /// For a group that holds nodal degrees of freedom of its own (the shells' rotations): the
+  /// nodes this rank owns (owned[mesh node] = 1), whose kinetic energy it books, and the nodal
+  /// array [3 n_nodes] of moments its internal forces accumulate, which the solver sums over the
+  /// ranks (ghosts into owners, then back) before the next cycle (null: none).
+  virtual void set_owned_nodes(const std::uint8_t* owned) { (void)owned; }
+  virtual double* nodal_moments() { return nullptr; }
 
   // Erosion (kinds that can lose elements; the defaults are for those that cannot).
   virtual bool can_erode() const { return false; }

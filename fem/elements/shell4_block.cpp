@@ -23,7 +23,7 @@ inline double len2(double a, double b) { return std::sqrt(a * a + b * b); }
 
 // Elements per pass: the geometry of a chunk stays in L1 between the pass that hands the
 // membrane law its deformation gradients and the pass that makes the forces.
-constexpr std::size_t kChunk = 64;
+constexpr std::size_t kChunk = kShell4Chunk;
 // Drilling spring per node: this share of the membrane stiffness times the area (N m/rad).
 constexpr double kDrillingRatio = 1e-3;
 
@@ -621,8 +621,9 @@ void shell4_internal_forces(Shell4Block& b, const double* x, const double* v, co
   // Membrane-law sections: the law sees a chunk's deformation gradients at once.
   alignas(64) double Nc[3][kChunk];
   std::vector<double> hist;
-  for (std::size_t c0 = 0; c0 < b.n; c0 += kChunk) {
-    const std::size_t m = std::min(kChunk, b.n - c0);
+  const std::size_t e_end = std::min(b.n, b.range_end);
+  for (std::size_t c0 = b.range_begin; c0 < e_end; c0 += kChunk) {
+    const std::size_t m = std::min(kChunk, e_end - c0);
     if (k.law) law_resultants(b, x, c0, m, Nc, hist);
     for (std::size_t j0 = 0; j0 < m; j0 += W) {
       const int cnt = static_cast<int>(std::min<std::size_t>(W, m - j0));

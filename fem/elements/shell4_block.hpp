@@ -33,6 +33,9 @@
 
 namespace ncfsim::fem {
 
+/// Shells per kernel chunk (a membrane law sees a chunk's deformation gradients at once).
+inline constexpr std::size_t kShell4Chunk = 64;
+
 struct Shell4Section {
   double thickness = 0;              // m
   int integration_points = 2;        // Gauss points through the thickness (elastic section)
@@ -49,6 +52,9 @@ struct Shell4Block {
   std::vector<std::int32_t> conn;        // [4][n] node indices, counter-clockwise about the normal
   std::vector<std::int64_t> user_id;     // [n]
   std::vector<std::int32_t> mesh_index;  // [n] index into the mesh's shell set
+  // The elements the per-cycle kernel integrates (a rank's share; all on one rank). The
+  // begin is a multiple of kShell4Chunk.
+  std::size_t range_begin = 0, range_end = static_cast<std::size_t>(-1);
 
   // Reference geometry.
   std::vector<double> area0;  // [n]

@@ -26,16 +26,37 @@ class Shell4Group final : public ElementGroup {
     omega_.assign(3 * n_nodes, 0.0);
     moment_.assign(3 * n_nodes, 0.0);
     inertia_.assign(n_nodes, 0.0);
-    std::vector<char> mine(n_nodes, 0);
-    for (auto node : block.conn) mine[static_cast<std::size_t>(node)] = 1;
-    for (std::size_t i = 0; i < n_nodes; ++i)
-      if (mine[i]) nodes_.push_back(static_cast<std::int32_t>(i));
+    collect_nodes(0, block.n);
     fixed_.assign(3 * n_nodes, 0);
     for (const auto& fx : model.fixed)
       for (auto node : fx.nodes)
         for (std::size_t c = 0; c < 3; ++c)
           if (fx.rotations[c]) fixed_[3 * static_cast<std::size_t>(node) + c] = 1;
     update_inertia();
+  }
+  // The nodes whose rotations this rank advances: those of elements [begin, end) and, on
+  // several ranks, the group's nodes it owns (their moments are summed there every cycle, so
+  // they must be cleared there too).
+  void collect_nodes(std::size_t begin, std::size_t end) {
+    std::vector<char> mine(omega_.size() / 3, 0);
+    for (std::size_t I = 0; I < 4; ++I)
+      for (std::size_t e = begin; e < std::min(end, block.n); ++e)
+        mine[static_cast<std::size_t>(block.conn[I * block.n + e])] = 1;
+    if (!owned_.empty())
+      for (auto node : block.conn)
+        if (owned_[static_cast<std::size_t>(node)]) mine[static_cast<std::size_t>(node)] = 1;
+    nodes_.clear();
+    for (std::size_t i = 0; i < mine.size(); ++i)
+      if (mine[i]) nodes_.push_back(static_cast<std::int32_t>(i));
+    // The group's other nodes: a rank that reads one as a ghost (a contact's halo) receives its
+    // owner's summed moment there, which must not go back as this rank's share.
+    others_.clear();
+    if (!owned_.empty())
+      for (auto node : block.conn)
+        if (!mine[static_cast<std::size_t>(node)]) {
+          mine[static_cast<std::size_t>(node)] = 1;
+          others_.push_back(node);
+        }
   }
   void update_inertia() {
     std::fill(inertia_.begin(), inertia_.end(), 0.0);
@@ -71,19 +92,24 @@ class Shell4Group final : public ElementGroup {
     // w^{n-1/2} from the moments at t^{n-1}; kinetic energy of the rotations at t^{n-1} in the
     // product form the solver uses for the translations (its change is booked one step late).
     const double dt_mid = 0.5 * (dt_last_ + s.dt);
+    // Several ranks: the moments are the sums over the ranks (nodal_moments), so every rank
+    // advances the rotations of its elements' nodes alike; each node's energy on its owner.
     double ke = 0;
     for (auto node : nodes_) {
       const auto i = static_cast<std::size_t>(node);
       const double inv_i = inertia_[i] > 0 ? 1.0 / inertia_[i] : 0.0;
+      const double booked = owned_.empty() || owned_[i] ? 0.5 * inertia_[i] : 0.0;
       for (std::size_t c = 0; c < 3; ++c) {
         const std::size_t d = 3 * i + c;
         const double wo = omega_[d];
         const double wn = fixed_[d] ? 0.0 : wo + dt_mid * moment_[d] * inv_i;
         omega_[d] = wn;
-        ke += 0.5 * inertia_[i] * wo * wn;
+        ke += booked * wo * wn;
         moment_[d] = 0;
       }
     }
+    for (auto node : others_)
+      for (std::size_t c = 0; c < 3; ++c) moment_[3 * static_cast<std::size_t>(node) + c] = 0;
     energy.kinetic += ke - ke_rot_;
     ke_rot_ = ke;
     dt_last_ = s.dt;
@@ -101,6 +127,26 @@ class Shell4Group final : public ElementGroup {
 
   const std::vector<double>& rotation_velocity() const { return omega_; }
 
+  // Domain decomposition.
+  std::size_t chunk() const override { return kShell4Chunk; }
+  bool set_range(std::size_t begin, std::size_t end) override {
+    block.range_begin = begin, block.range_end = end;
+    collect_nodes(begin, end);
+    return true;
+  }
+  void set_owned_nodes(const std::uint8_t* owned) override {
+    owned_.assign(owned, owned + omega_.size() / 3);
+    collect_nodes(block.range_begin, block.range_end);
+  }
+  double* nodal_moments() override { return moment_.data(); }
+  std::vector<std::pair<double*, int>> state_arrays() override {
+    std::vector<std::pair<double*, int>> a;
+    for_each_element_array(*this, [&](const char*, std::vector<double>& v) {
+      if (block.n > 0 && !v.empty()) a.emplace_back(v.data(), static_cast<int>(v.size() / block.n));
+    });
+    return a;
+  }
+
   void save_state(CheckpointWriter& w) const override {
     for_each_state_array(*this, [&](const char* name, const auto& v) { save_array(w, name, v); });
     w.write_double("dt_last", dt_last_);
@@ -115,17 +161,24 @@ class Shell4Group final : public ElementGroup {
  private:
   std::vector<double> omega_, moment_, inertia_;  // [3 n], [3 n], [n] over all mesh nodes
   std::vector<std::uint8_t> fixed_;               // [3 n] rotation held at zero
-  std::vector<std::int32_t> nodes_;               // the group's nodes
+  std::vector<std::int32_t> nodes_;               // the nodes of its elements (this rank's)
+  std::vector<std::uint8_t> owned_;               // several ranks: [n] nodes this rank owns
+  std::vector<std::int32_t> others_;              // several ranks: see collect_nodes
   double dt_last_ = 0, ke_rot_ = 0;
 
   // The arrays a checkpoint holds, by name: save and load walk the same list.
+  // The per-element ones ([components][n] each) first: an output on several ranks gathers those.
   template <class Group, class Fn>
-  static void for_each_state_array(Group& g, Fn&& fn) {
+  static void for_each_element_array(Group& g, Fn&& fn) {
     auto& b = g.block;
     fn("strain", b.strain), fn("curvature", b.curvature), fn("shear", b.shear);
     fn("resultant", b.resultant), fn("moment", b.moment), fn("shear_force", b.shear_force);
     fn("hg_force", b.hg_force), fn("drill_moment", b.drill_moment);
     fn("polar_angle", b.polar_angle), fn("history", b.history);
+  }
+  template <class Group, class Fn>
+  static void for_each_state_array(Group& g, Fn&& fn) {
+    for_each_element_array(g, fn);
     fn("rotation_velocity", g.omega_), fn("nodal_moment", g.moment_);
   }
 };

@@ -166,10 +166,12 @@ TEST(MpiRuns, WhatCannotBeSplitIsRefused) {
   EXPECT_NE(r.output.find("cantilever.toml: key '--np': 2 MPI ranks"), std::string::npos)
       << "the case file and the key, each once: " << r.output;
 
+  // 40 shells: one kernel chunk of 64.
   r = run_cli({"run", (kSource / "cases/verification/shell_cantilever.toml").string(), "-o",
                fresh_dir("mpi_shells").string(), "--np", "2"});
   EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find("cannot run on several MPI ranks yet"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("2 MPI ranks for 40 elements"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("64 shells"), std::string::npos) << r.output;
 
   // A workflow started by mpirun (`--np` runs its engine stages on N ranks each instead:
   // tests/workflow/test_mpi_resume.cpp).

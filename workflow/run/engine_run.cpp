@@ -645,6 +645,22 @@ void log_end(const Run& r, const fem::ExplicitSolver& solver) {
         elem_cycles > 0 ? 1e9 * share * tm.internal_force / elem_cycles : 0.0,
         1e9 * r.loop_cpu / loop_ec);
   }
+  // Each counted contact's cost (bench_contact's figure: docs/performance.md), this rank's.
+  const double cpu_share = r.loop_wall > 0 ? r.loop_cpu / r.loop_wall : 1.0;
+  const auto& contacts = solver.model().contacts;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const double nodes = static_cast<double>(contacts[k]->n_contact_nodes());
+    const std::int64_t searches = contacts[k]->n_broad_phase_searches();
+    // Timers count this process's loop only (a resumed run: since the resume).
+    const double cycles = static_cast<double>(r.loop_cycles);
+    if (nodes <= 0 || cycles <= 0) continue;
+    const double secs = solver.contact_seconds(k);
+    r.log->info(
+        "contact '{}'{}: {} contact nodes, {} broad-phase searches so far, {:.3g} s in {} cycles: "
+        "~{:.0f} ns of CPU per contact node-cycle",
+        contacts[k]->name(), solver.domain() ? " (rank 0's share)" : "", nodes, searches, secs,
+        r.loop_cycles, 1e9 * cpu_share * secs / (nodes * cycles));
+  }
 }
 
 void draw_figures_and_report(const Run& r) {
