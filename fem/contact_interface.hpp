@@ -53,6 +53,8 @@ class ContactAlgorithm {
   /// broad-phase searches (bucket sorts) made so far.
   virtual std::size_t n_contact_nodes() const { return 0; }
   virtual std::int64_t n_broad_phase_searches() const { return 0; }
+  /// Where the time went and what was searched, in words, for the run's log (empty: nothing).
+  virtual std::string cost_details() const { return {}; }
   /// The elements `mesh_elements` (mesh-wide indices: Mesh::element_offset of the kind plus the
   /// index in its set) were eroded: their faces stop being contact segments from the next
   /// add_forces on, and the faces of their neighbours that they covered start being ones.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <sstream>
 #include <unordered_set>
 
 #include "fem/checkpoint.hpp"
@@ -738,6 +739,17 @@ void PenaltyContact::load_state(CheckpointReader& r) {
   stats_.max_penetration = values[0], stats_.run_max_penetration = values[1];
   stats_.sort_seconds = values[2], stats_.check_seconds = values[3];
   stats_.narrow_seconds = values[4];
+}
+
+std::string PenaltyContact::cost_details() const {
+  const double n = static_cast<double>(std::max<std::size_t>(surf_.n_nodes(), 1));
+  std::ostringstream os;
+  os.precision(3);
+  os << "candidates per node " << static_cast<double>(stats_.n_candidates) / n
+     << ", active contacts per node " << static_cast<double>(active_contacts()) / n
+     << "; bucket sorts " << stats_.sort_seconds << " s, displacement checks "
+     << stats_.check_seconds << " s, narrow phase and forces " << stats_.narrow_seconds << " s";
+  return os.str();
 }
 
 }  // namespace ncfsim::fem

@@ -100,6 +100,7 @@ class PenaltyContact final : public ContactAlgorithm {
   double search_margin() const { return margin_; }
   std::size_t n_contact_nodes() const override { return surf_.n_nodes(); }
   std::int64_t n_broad_phase_searches() const override { return stats_.n_sorts; }
+  std::string cost_details() const override;
 
  private:
   void sort_segments(const double* x);                      // broad phase at positions x

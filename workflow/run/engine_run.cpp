@@ -660,6 +660,8 @@ void log_end(const Run& r, const fem::ExplicitSolver& solver) {
         "~{:.0f} ns of CPU per contact node-cycle",
         contacts[k]->name(), solver.domain() ? " (rank 0's share)" : "", nodes, searches, secs,
         r.loop_cycles, 1e9 * cpu_share * secs / (nodes * cycles));
+    if (const std::string d = contacts[k]->cost_details(); !d.empty())
+      r.log->info("contact '{}': {}", contacts[k]->name(), d);
   }
 }
 
