@@ -49,8 +49,8 @@ class ContactAlgorithm {
   virtual std::int64_t active_contacts() const { return 0; }
   /// Deepest penetration past the contact thickness over the run so far, m (0: not tracked).
   virtual double max_penetration() const { return 0; }
-  /// Cost counters for the run's log (0: not counted): the contact nodes searched and the
-  /// broad-phase searches (bucket sorts) made so far.
+  /// Cost counters for the run's log (0: not counted): the contact nodes this rank searches
+  /// (its own on several ranks) and the broad-phase searches (bucket sorts) made so far.
   virtual std::size_t n_contact_nodes() const { return 0; }
   virtual std::int64_t n_broad_phase_searches() const { return 0; }
   /// Where the time went and what was searched, in words, for the run's log (empty: nothing).

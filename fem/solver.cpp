@@ -252,6 +252,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
       c->initialise(setup);
       dt_ = std::min(dt_, c->stable_step_limit());
     }
+    contact_seconds_.assign(model_.contacts.size(), 0.0);
   }
   if (domain_) {
     // What each rank's contacts read of the others, then the exchange that keeps it current.
@@ -856,7 +857,6 @@ void ExplicitSolver::contact_forces(const CycleArrays& a, Cycle& c) {
   const double dt_c = dt_prev_ > 0 ? dt_prev_ : c.dt_new;
   try {
     for (auto& tool : model_.tools) tool_contact_forces(tool, a.x, a.v, a.m, dt_c, a.fc);
-    contact_seconds_.resize(model_.contacts.size(), 0.0);
     for (std::size_t q = 0; q < model_.contacts.size(); ++q) {
       const auto t0 = Clock::now();
       auto& k = model_.contacts[q];

@@ -263,6 +263,7 @@ void PenaltyContact::restrict_to_rank(const std::uint8_t* owned, const std::uint
   node_mine_.assign(surf_.n_nodes(), 0);
   for (std::size_t e = 0; e < surf_.n_nodes(); ++e)
     node_mine_[e] = owned[static_cast<std::size_t>(surf_.node[e])];
+  n_mine_ = static_cast<std::size_t>(std::count(node_mine_.begin(), node_mine_.end(), 1));
   node_readable_.clear();
   for (std::size_t e = 0; e < surf_.n_nodes(); ++e)
     if (readable[static_cast<std::size_t>(surf_.node[e])])
@@ -742,7 +743,7 @@ void PenaltyContact::load_state(CheckpointReader& r) {
 }
 
 std::string PenaltyContact::cost_details() const {
-  const double n = static_cast<double>(std::max<std::size_t>(surf_.n_nodes(), 1));
+  const double n = static_cast<double>(std::max<std::size_t>(n_contact_nodes(), 1));
   std::ostringstream os;
   os.precision(3);
   os << "candidates per node " << static_cast<double>(stats_.n_candidates) / n

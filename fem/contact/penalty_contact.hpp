@@ -98,7 +98,10 @@ class PenaltyContact final : public ContactAlgorithm {
   const ContactSurface& surface() const { return surf_; }
   const PenaltyContactStats& stats() const { return stats_; }
   double search_margin() const { return margin_; }
-  std::size_t n_contact_nodes() const override { return surf_.n_nodes(); }
+  /// The surface nodes this rank searches: all, or those it owns after restrict_to_rank.
+  std::size_t n_contact_nodes() const override {
+    return node_mine_.empty() ? surf_.n_nodes() : n_mine_;
+  }
   std::int64_t n_broad_phase_searches() const override { return stats_.n_sorts; }
   std::string cost_details() const override;
 
@@ -192,6 +195,7 @@ class PenaltyContact final : public ContactAlgorithm {
   // Several ranks: [n_seg] 1: a segment this rank cannot read (beyond its halo); [n_snode] 1: a
   // surface node this rank owns (empty on one rank: every node).
   std::vector<std::uint8_t> seg_remote_, node_mine_;
+  std::size_t n_mine_ = 0;  // surface nodes this rank owns (after restrict_to_rank)
   // Several ranks: segments this rank reads that share a corner with one it does not (the edge
   // of its contact halo). An owned node finding one among its candidates has slid about the
   // halo's width relative to the other surface: the contact beyond would be missed.
