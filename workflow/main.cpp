@@ -232,6 +232,9 @@ int main(int argc, char** argv) {
   cal_macro->add_option("--bias-negative", mc.bias_negative,
                         "Meso bias-extension run folder, negative (a check)");
   cal_macro->add_flag("--symmetric", mc.symmetric, "One curve: the mean of the two signs");
+  cal_macro->add_flag("--stitch-bars", mc.stitch_bars,
+                      "The stitch as bars on the shells ([[mesh.shell_stitch]]): the positive "
+                      "curve less the pillars' kinematic force, and the pillar law");
   cal_macro->add_option("--frame", mc.frame, "Picture-frame name in the runs (default frame)");
   cal_macro->add_option("--name", mc.name, "[[membrane_law]] name (default ncf_macro)");
   cal_macro->add_option("--step", mc.step_deg, "Angle step of the curve, deg (default 2.5)");

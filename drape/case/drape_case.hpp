@@ -10,6 +10,8 @@
 
 #include "drape/fabric_generator.hpp"
 #include "drape/probe_specs.hpp"
+#include "drape/shell_stitch.hpp"
+#include "drape/shell_stitch_connection.hpp"
 #include "drape/stitch_connection.hpp"
 #include "fem/case/case_context.hpp"
 
@@ -39,6 +41,28 @@ void renumber_fabrics(fem::CaseReadContext& ctx, std::vector<FabricEntry>& fabri
 /// laws) and their stitch-to-tow connections (into ctx.model.contacts).
 std::vector<FabricSummary> assign_fabric_parts(fem::CaseReadContext& ctx,
                                                const std::vector<FabricEntry>& fabrics);
+
+/// One [[mesh.shell_stitch]] between its generation and its bar law and sliders.
+struct ShellStitchEntry {
+  std::string name, path, law;
+  int bar_part = -1;
+  ShellStitchModel model;
+  ShellStitchSliderSettings slider;  // sliding_force per penetration of the fabric (as read)
+  double added_mass_per_area = 0;    // kg/m^2 carried by the stitch nodes on top of the yarn's
+};
+
+/// [[mesh.shell_stitch]] of the [mesh] table `m`: lays the stitch lines over their shell parts
+/// (after fem's plates, before fem::finish_mesh); the bar parts are marked generated.
+std::vector<ShellStitchEntry> read_shell_stitches(fem::CaseReadContext& ctx,
+                                                  const fem::TableReader& m);
+/// After fem::finish_mesh: renumbers the links and registers the lines' end nodes as the node
+/// selector `shell_stitch_ends = "<name>"` (a frame or a clamp holds them).
+void renumber_shell_stitches(fem::CaseReadContext& ctx, std::vector<ShellStitchEntry>& stitches,
+                             const std::vector<std::int32_t>& new_of_old);
+/// After fem::read_bar_laws and fem::read_parts: each line's bar law (the pillar law scaled by
+/// the pillars a line stands for) and its sliders (into ctx.model.contacts).
+void assign_shell_stitch_parts(fem::CaseReadContext& ctx,
+                               const std::vector<ShellStitchEntry>& stitches);
 
 /// [[output.shear_probe]] and [[output.bending_length]] of the [output] table `o`.
 std::vector<ShearProbe> read_shear_probes(const fem::CaseReadContext& ctx,

@@ -1,12 +1,14 @@
 #include "workflow/calibrate/calibrate_macro.hpp"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
+#include "drape/fabric.hpp"
 #include "drape/stitch_calibration.hpp"
 #include "fem/errors.hpp"
 #include "workflow/output/output_files.hpp"
@@ -120,6 +122,18 @@ double bias_extension_force_from_curve(const FrameCurve& c, double H, double W, 
                0.5 * area_b * curve_force(c, 0.5 * g * deg) * std::cos(0.5 * g));
 }
 
+double pillar_shear_force(const std::vector<double>& strain, const std::vector<double>& force,
+                          double gauge, double angle_deg) {
+  const double g = angle_deg * M_PI / 180, e = std::sqrt(2.0) * std::cos(M_PI / 4 - g / 2) - 1;
+  if (e <= 0 || strain.size() < 2) return 0.0;
+  std::size_t k = 1;
+  while (k + 1 < strain.size() && e > strain[k]) ++k;
+  const double tension =
+      force[k - 1] + (force[k] - force[k - 1]) * (e - strain[k - 1]) / (strain[k] - strain[k - 1]);
+  const double de_dg = std::sqrt(2.0) / 2 * std::sin(M_PI / 4 - g / 2);
+  return tension * de_dg / gauge / std::cos(g);
+}
+
 namespace {
 
 struct MesoRun {
@@ -195,6 +209,56 @@ FrameSource frame_curve(const std::filesystem::path& dir, const std::string& opt
                        std::filesystem::absolute(r.history).lexically_normal().string(),
                        r.summary_case, r.table.rows.size(), top);
   return s;
+}
+
+// The positive meso frame's 'I' pillar law and stitch gauge, from the case.toml of its run.
+struct PillarSource {
+  std::string law_name;
+  std::vector<double> strain, force;
+  double linear_density = 0, gauge = 0;
+  bool tension_only = true;
+};
+
+PillarSource pillar_source(const std::filesystem::path& dir) {
+  const auto file = dir / "case.toml";
+  const std::string f = file.string();
+  toml::table root;
+  try {
+    root = toml::parse_file(f);
+  } catch (const toml::parse_error& e) {
+    throw InputError(f, "",
+                     std::string("--stitch-bars reads the positive run's case: ") +
+                         std::string(e.description()));
+  }
+  const toml::array* fabrics = root["mesh"]["fabric"].as_array();
+  if (!fabrics || fabrics->empty() || !fabrics->get(0)->is_table())
+    throw InputError(f, "mesh.fabric", "--stitch-bars needs the meso frame's [[mesh.fabric]]");
+  const toml::table& fb = *fabrics->get(0)->as_table();
+  PillarSource p;
+  p.law_name = fb["stitch_law_I"].value_or(std::string());
+  if (p.law_name.empty())
+    throw InputError(f, "mesh.fabric[0].stitch_law_I", "--stitch-bars needs the pillar law");
+  drape::FabricSpec spec;
+  spec.tow_width = fb["tow_width"].value_or(spec.tow_width);
+  spec.tow_gap = fb["tow_gap"].value_or(spec.tow_gap);
+  spec.stitch_gauge = fb["stitch_gauge"].value_or(0.0);
+  p.gauge = spec.gauge();
+  if (const toml::array* laws = root["bar_law"].as_array())
+    for (const auto& n : *laws) {
+      const toml::table* law = n.as_table();
+      if (!law || (*law)["name"].value_or(std::string()) != p.law_name) continue;
+      if (const auto* a = (*law)["strain"].as_array())
+        for (const auto& v : *a) p.strain.push_back(v.value_or(NAN));
+      if (const auto* a = (*law)["force"].as_array())
+        for (const auto& v : *a) p.force.push_back(v.value_or(NAN));
+      p.linear_density = (*law)["linear_density"].value_or(0.0);
+      p.tension_only = (*law)["tension_only"].value_or(true);
+    }
+  if (p.strain.size() < 2 || p.strain.size() != p.force.size())
+    throw InputError(f, "bar_law",
+                     "--stitch-bars: no tabulated [[bar_law]] '" + p.law_name +
+                         "' (strain, force) in the positive run's case");
+  return p;
 }
 
 std::string clip_note(const std::string& what, const ResampledCurve& c) {
@@ -303,6 +367,22 @@ MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
                                 {"negative", &cal.negative},
                                 {"unstitched", &cal.unstitched}})
     if (const auto n = clip_note(what, *c); !n.empty()) cal.notes.push_back(n);
+  PillarSource pillars;
+  if (o.stitch_bars) {
+    if (o.symmetric)
+      throw InputError("", "--stitch-bars", "give either --stitch-bars or --symmetric");
+    pillars = pillar_source(o.positive);
+    // The tows' share of the positive frame; held monotone (the pillars' force grows faster
+    // than the frame's below a few degrees, where both are noise).
+    double top = 0;
+    for (std::size_t i = 0; i < cal.positive.curve.angle_deg.size(); ++i) {
+      double& f = cal.positive.curve.force[i];
+      f -= pillar_shear_force(pillars.strain, pillars.force, pillars.gauge,
+                              cal.positive.curve.angle_deg[i]);
+      f = std::max({f, top, 0.0});
+      top = f;
+    }
+  }
   if (o.symmetric) cal.symmetric = average_curves(cal.positive.curve, cal.negative.curve);
 
   // The file: where each curve came from, the constants, the block(s).
@@ -316,6 +396,13 @@ MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
       "#   positive shear (wales along the opening diagonal, stitch stretched):\n#     {}\n"
       "#   negative shear (wales across it): {}\n",
       kVersion, o.step_deg, 0.5 * o.step_deg, pos.text, neg.text);
+  if (o.stitch_bars)
+    t += fmt::format(
+        "# --stitch-bars: the stitch is carried by bars sewn on the shells ([[mesh.shell_stitch]]\n"
+        "# with law = \"{}\", below): the positive curve is the tows' share, the positive frame\n"
+        "# less its 'I' pillars' kinematic force (Eq. 4-5: the pillar law and gauge {:.4g} m of\n"
+        "# the positive run's case.toml).\n",
+        pillars.law_name, pillars.gauge);
   if (o.symmetric)
     t += "# --symmetric: one curve, the mean of the two signs (the classic symmetric macro law).\n";
   else
@@ -344,6 +431,13 @@ MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
     curve_lines(cal.positive.curve, "shear_angle_deg", "shear_force");
     curve_lines(cal.negative.curve, "negative_shear_angle_deg", "negative_shear_force");
   }
+  if (o.stitch_bars)
+    t += fmt::format(
+        "\n# The 'I' pillar law of the meso frame (its [[bar_law]] '{}'), for the stitch bars:\n"
+        "[[bar_law]]\nname = \"{}\"\ntype = \"tabulated\"\ntension_only = {}\n"
+        "linear_density = {:g}\nstrain = [{}]\nforce = [{}]   # N\n",
+        pillars.law_name, pillars.law_name, pillars.tension_only ? "true" : "false",
+        pillars.linear_density, numbers(pillars.strain, "{:g}"), numbers(pillars.force, "{:g}"));
   if (!o.unstitched.empty()) {
     t += fmt::format(
         "\n# The same fabric without its stitch (symmetric), from the unstitched meso frame:\n#   "

@@ -51,6 +51,13 @@ double curve_force(const FrameCurve& c, double angle_deg);
 /// monotone again (running maximum).
 FrameCurve average_curves(const FrameCurve& a, const FrameCurve& b);
 
+/// Normalised shear force (N/m) of tricot 'I' pillars (tension T(e) of `pillar`, a gauge apart)
+/// that follow a picture frame exactly in positive shear: they stretch by
+/// e = sqrt(2) cos(45 deg - g/2) - 1 (paper Eq. 4-5); their power per unit area T de/dg dg/dt /
+/// gauge over cos(g) dg/dt (the frame's F_sh L cos g dg/dt on an area L^2 cos g).
+double pillar_shear_force(const std::vector<double>& strain, const std::vector<double>& force,
+                          double gauge, double angle_deg);
+
 /// Bias-extension force (N) of a coupon of free length H and width W (m) at extension D (m) from
 /// a frame curve, for ideal trellising (pin-jointed kinematics, inextensible fibres; Harrison et
 /// al. 2004, the energy of the law F_sh cos(g) dg per unit area): the central zone (area
@@ -68,6 +75,11 @@ struct MacroCalibrationOptions {
   std::string frame = "frame";       // the [[boundary.picture_frame]] name of the meso runs
   std::string name = "ncf_macro";    // the [[membrane_law]] name
   bool symmetric = false;            // one curve, the mean of the two signs
+  // The stitch is carried by bars on the shells ([[mesh.shell_stitch]]): the positive curve is
+  // the tows' share, the positive frame less its 'I' pillars' kinematic force (paper Eq. 4-5,
+  // the pillar law and gauge of the positive run's case.toml), and the pillar law is written
+  // beside the membrane law.
+  bool stitch_bars = false;
   double step_deg = 2.5;             // grid of the macro curve
   double max_angle_deg = 0;          // 0: as far as both runs reach
   // Constants the picture frame does not give (defaults: the representative fabric of

@@ -24,8 +24,14 @@ void read_case_header(const TableReader& root, EngineCase& ec) {
   ec.description = c.string("description", "");
 }
 
-// [mesh]: fem's blocks and lines, drape's fabrics, then the renumbering both follow.
-std::vector<drape::FabricEntry> read_mesh(CaseReadContext& ctx) {
+struct DrapeMeshEntries {
+  std::vector<drape::FabricEntry> fabrics;
+  std::vector<drape::ShellStitchEntry> shell_stitches;
+};
+
+// [mesh]: fem's blocks, lines and plates, drape's fabrics and shell stitches, then the renumbering
+// all follow.
+DrapeMeshEntries read_mesh(CaseReadContext& ctx) {
   if (!ctx.root.has("mesh"))
     ctx.root.fail("mesh",
                   "missing (required section [mesh] with [[mesh.block]] or [[mesh.line]] entries)");
@@ -36,10 +42,13 @@ std::vector<drape::FabricEntry> read_mesh(CaseReadContext& ctx) {
     m.fail("block",
            "the mesh has no elements: give at least one [[mesh.block]], [[mesh.line]], "
            "[[mesh.plate]] or [[mesh.fabric]]");
-  auto fabrics = drape::read_fabrics(ctx, m);
+  DrapeMeshEntries d;
+  d.fabrics = drape::read_fabrics(ctx, m);
+  d.shell_stitches = drape::read_shell_stitches(ctx, m);
   const auto new_of_old = fem::finish_mesh(ctx);
-  drape::renumber_fabrics(ctx, fabrics, new_of_old);
-  return fabrics;
+  drape::renumber_fabrics(ctx, d.fabrics, new_of_old);
+  drape::renumber_shell_stitches(ctx, d.shell_stitches, new_of_old);
+  return d;
 }
 
 SummaryMean read_mean(const TableReader& t) {
@@ -206,18 +215,19 @@ EngineCase load_engine_case(const std::filesystem::path& file,
         "model",
         "missing: a crush case reads its part from a transfer's results ([model] source = ...)");
   impact::ImpregnatedImport import;
-  std::vector<drape::FabricEntry> fabrics;
+  DrapeMeshEntries drape_mesh;
   if (imported)
     import = impact::read_impregnated_model(ctx);
   else
-    fabrics = read_mesh(ctx);
+    drape_mesh = read_mesh(ctx);
   ec.resolution = ctx.resolution;
   fem::read_materials(ctx);
   fem::read_bar_laws(ctx);
   fem::read_membrane_laws(ctx);
   fem::read_parts(ctx);
   if (imported) impact::assign_impregnated_parts(ctx, import);
-  ec.fabric_summaries = drape::assign_fabric_parts(ctx, fabrics);
+  ec.fabric_summaries = drape::assign_fabric_parts(ctx, drape_mesh.fabrics);
+  drape::assign_shell_stitch_parts(ctx, drape_mesh.shell_stitches);
   fem::check_parts_defined(ctx);
   fem::read_boundary(ctx);
   fem::read_loads(ctx);

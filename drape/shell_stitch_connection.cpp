@@ -1,0 +1,103 @@
+#include "drape/shell_stitch_connection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "fem/checkpoint.hpp"
+#include "fem/errors.hpp"
+#include "fem/mesh.hpp"
+
+namespace ncfsim::drape {
+
+StitchToShellConnection::StitchToShellConnection(std::string name,
+                                                 std::vector<ShellStitchLink> links,
+                                                 ShellStitchSliderSettings s)
+    : name_(std::move(name)), s_(s), links_(std::move(links)) {
+  if (!(s_.sliding_force > 0)) throw std::invalid_argument("sliding_force must be > 0");
+  if (!(s_.stiffness_scale > 0 && s_.stiffness_scale <= 1))
+    throw std::invalid_argument("stiffness_scale must be in (0, 1]");
+}
+
+void StitchToShellConnection::initialise(const fem::ContactSetup& setup) {
+  const std::size_t n = links_.size(), nn = setup.mesh->n_nodes();
+  k_.assign(n, 0.0);
+  slip_.assign(n, 0.0);
+  slip_len_.assign(n, 0.0);
+  force_.assign(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& l = links_[i];
+    for (auto nd : l.host)
+      if (nd < 0 || static_cast<std::size_t>(nd) >= nn)
+        throw InputError("", name_, "a stitch link's host shell has an invalid node");
+    if (l.stitch_node < 0 || static_cast<std::size_t>(l.stitch_node) >= nn)
+      throw InputError("", name_, "a stitch link has an invalid stitch node");
+    // The mass the spring sees at the shell point: 1 / sum(w^2 / m) over the host's nodes.
+    double inv = 0;
+    for (int k = 0; k < 4; ++k)
+      inv += l.weight[k] * l.weight[k] / setup.mass[3 * static_cast<std::size_t>(l.host[k])];
+    const double m = std::min(setup.mass[3 * static_cast<std::size_t>(l.stitch_node)], 1 / inv);
+    k_[i] = s_.stiffness_scale * m / (setup.dt * setup.dt);
+  }
+}
+
+void StitchToShellConnection::add_forces(const double* x, const double*, const double*, double,
+                                         double* f) {
+  n_sliding_ = 0;
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    const auto& l = links_[i];
+    const auto a = 3 * static_cast<std::size_t>(l.stitch_node);
+    // The anchor: the material point of the host a slip s along the line from the sewn point;
+    // t: the line's reference tangent convected by the host (|t| = stretch along the line).
+    double w[4], p[3] = {0, 0, 0}, t[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k) {
+      w[k] = l.weight[k] + slip_[i] * l.slide[k];
+      const auto h = 3 * static_cast<std::size_t>(l.host[k]);
+      for (int d = 0; d < 3; ++d) p[d] += w[k] * x[h + d], t[d] += l.slide[k] * x[h + d];
+    }
+    double u[3];
+    for (int d = 0; d < 3; ++d) u[d] = x[a + d] - p[d];
+    const bool end = l.prev < 0 || l.next < 0;
+    const double tl = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    if (!(end && s_.tie_ends) && tl > 0) {
+      const double ut = (u[0] * t[0] + u[1] * t[1] + u[2] * t[2]) / tl;
+      const double limit = s_.sliding_force / k_[i];
+      if (std::abs(ut) > limit) {
+        const double ds = ut - std::copysign(limit, ut);  // m, in the current configuration
+        slip_[i] += ds / tl;
+        slip_len_[i] += std::abs(ds);
+        dissipated_ += s_.sliding_force * std::abs(ds);
+        for (int k = 0; k < 4; ++k) w[k] = l.weight[k] + slip_[i] * l.slide[k];
+        for (int d = 0; d < 3; ++d) u[d] -= ds * t[d] / tl;
+        ++n_sliding_;
+      }
+    }
+    const double fk[3] = {-k_[i] * u[0], -k_[i] * u[1], -k_[i] * u[2]};
+    force_[i] = std::sqrt(fk[0] * fk[0] + fk[1] * fk[1] + fk[2] * fk[2]);
+    for (int d = 0; d < 3; ++d) f[a + d] += fk[d];
+    for (int k = 0; k < 4; ++k) {
+      const auto h = 3 * static_cast<std::size_t>(l.host[k]);
+      for (int d = 0; d < 3; ++d) f[h + d] -= w[k] * fk[d];
+    }
+  }
+}
+
+void StitchToShellConnection::save_state(fem::CheckpointWriter& w) const {
+  w.write_int("n_links", static_cast<std::int64_t>(links_.size()));
+  fem::save_array(w, "slip", slip_);
+  fem::save_array(w, "slip_length", slip_len_);
+  fem::save_array(w, "force", force_);
+  w.write_double("dissipated", dissipated_);
+  w.write_int("n_sliding", n_sliding_);
+}
+
+void StitchToShellConnection::load_state(fem::CheckpointReader& r) {
+  r.check_int("n_links", static_cast<std::int64_t>(links_.size()));
+  fem::load_array(r, "slip", slip_);
+  fem::load_array(r, "slip_length", slip_len_);
+  fem::load_array(r, "force", force_);
+  dissipated_ = r.read_double("dissipated");
+  n_sliding_ = r.read_int("n_sliding");
+}
+
+}  // namespace ncfsim::drape

@@ -1,0 +1,60 @@
+#pragma once
+// The slider that sews a macro stitch line to its shells (drape/shell_stitch.hpp): a spring
+// between each stitch node and its point on the host shell (bilinear weights of the host's
+// nodes). Along the stitch (the line's reference tangent convected by the host shell) the spring
+// holds up to the sliding force, beyond which the yarn slides through the fabric: the slip is kept
+// as a reference length along the line and moves the spring's anchor to the material point it
+// reaches (weights linear in the slip, so the forces on the host's nodes are those of a spring
+// between two points, with no follower terms). Across the line and out of the plane it stays
+// elastic: the stitch stays sewn to its row of the fabric. The ends of a line may be
+// tied (no slip: held by a clamp or a frame, as the meso frame holds its stitch ends).
+// Implemented as a contact of the engine: forces into the contact forces (they sum to zero),
+// the slip work into friction_dissipation.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drape/shell_stitch.hpp"
+#include "fem/contact_interface.hpp"
+
+namespace ncfsim::drape {
+
+struct ShellStitchSliderSettings {
+  double sliding_force = 0.1;  // N per stitch node (> 0; the reader scales it by the node's share)
+  bool tie_ends = false;       // the lines' end nodes do not slide
+  double stiffness_scale = 0.1;  // k = scale * min(m_stitch, m_point) / dt^2: never lowers the step
+};
+
+class StitchToShellConnection final : public fem::ContactAlgorithm {
+ public:
+  StitchToShellConnection(std::string name, std::vector<ShellStitchLink> links,
+                          ShellStitchSliderSettings s);
+  const std::string& name() const override { return name_; }
+  void initialise(const fem::ContactSetup& setup) override;
+  void add_forces(const double* x, const double* v, const double* mass, double dt,
+                  double* f_contact) override;
+  double friction_dissipation() const override { return dissipated_; }
+  std::int64_t active_contacts() const override { return n_sliding_; }
+  void save_state(fem::CheckpointWriter& w) const override;
+  void load_state(fem::CheckpointReader& r) override;
+
+  std::size_t size() const { return links_.size(); }
+  /// Slip of link i along its line so far (m of the line's reference length, signed: along
+  /// the direction given to the stitch positive).
+  double slip(std::size_t i) const { return slip_[i]; }
+  /// Path length slid by link i so far (m).
+  double slip_length(std::size_t i) const { return slip_len_[i]; }
+  double stiffness(std::size_t i) const { return k_[i]; }
+  /// Force of the spring on the stitch node after the last add_forces (N, magnitude).
+  double force_magnitude(std::size_t i) const { return force_[i]; }
+
+ private:
+  std::string name_;
+  ShellStitchSliderSettings s_;
+  std::vector<ShellStitchLink> links_;
+  std::vector<double> k_, slip_, slip_len_, force_;
+  double dissipated_ = 0;
+  std::int64_t n_sliding_ = 0;
+};
+
+}  // namespace ncfsim::drape
