@@ -6,7 +6,12 @@
 //   meso normalised shear force within 10 % from 5 to 40 deg (the acceptance of #19);
 // - the macro bias extensions keep their measured force and centre shear (the negative one
 //   trellises, Eq. 2); at the meso coupons' centre angles their force lies within 2-25 % of the
-//   meso force (the acceptance's 10 % is not met; the numbers are printed, docs/fabric-data.md).
+//   meso force (the acceptance's 10 % is not met; the numbers are printed, docs/fabric-data.md);
+// - the stitched macro model (cases/drape/macro/stitched: the stitch as bars sewn onto the shells)
+//   gives the meso frames back within 1 % and the meso bias coupons' force and centre shear at each
+//   extension within 10 % / 1.5-3 deg, except the positive coupon's first 5 mm (+11 %) and the
+//   negative one's 40 mm (not checked: +38 %);
+// - a stitch line pulled through clamped shells carries the sum of its sliding forces (Coulomb).
 #include <gtest/gtest.h>
 #include <toml++/toml.h>
 
@@ -114,6 +119,49 @@ TEST(CliMacroCalibration, SymmetricIsTheMeanOfTheTwoSigns) {
   EXPECT_FALSE(law.contains("negative_shear_force"));
 }
 
+// --stitch-bars: the positive frame less its pillars' kinematic force (paper Eq. 4-5, the pillar
+// law and gauge of the positive run's case.toml) is the tows' curve; the pillar law is written
+// beside the membrane law. A positive frame made of F = 2 g plus the pillars gives 2 g back.
+TEST(CliMacroCalibration, StitchBarsSubtractThePillarsKinematicForce) {
+  const std::vector<double> strain{0, 0.05, 0.4}, force{0, 1.0, 12.0};
+  const double gauge = 4e-3;
+  const auto pos = fake_frame_run("mcsb_pos", 40, [&](double g) {
+    return 2 * g + workflow::pillar_shear_force(strain, force, gauge, g);
+  });
+  std::ofstream(pos / "case.toml")
+      << "[[mesh.fabric]]\nname = \"cell\"\nstitch_law_I = \"pillar\"\nstitch_gauge = 4e-3\n"
+         "[[bar_law]]\nname = \"pillar\"\ntype = \"tabulated\"\ntension_only = true\n"
+         "linear_density = 7e-6\nstrain = [0, 0.05, 0.4]\nforce = [0, 1.0, 12.0]\n";
+  const auto neg = fake_frame_run("mcsb_neg", 40, [](double g) { return 2 * g; });
+  const fs::path out = fresh_dir("mcsb_out") / "law.toml";
+  const auto r = run_cli({"calibrate", "macro", "--positive", pos.string(), "--negative",
+                          neg.string(), "--stitch-bars", "-o", out.string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  // The pillars' force at 30 deg: e = sqrt(2) cos(30 deg) - 1 = 0.2247, T = 1 + 11 (0.1747 /
+  // 0.35) = 6.49 N, de/dg = sqrt(2)/2 sin(30 deg) = 0.354: T de/dg / G / cos(30 deg) = 662.7 N/m.
+  EXPECT_NEAR(workflow::pillar_shear_force(strain, force, gauge, 30), 662.7, 0.5);
+  const auto law = first_law(out);
+  const auto a = numbers(law, "shear_angle_deg"), f = numbers(law, "shear_force");
+  ASSERT_EQ(a.size(), 17u);
+  // Within the resampling's smoothing of the frame curve (a line through +-1.25 deg of rows; the
+  // pillars' curve has a kink at 5.9 deg, e = 0.05): 0.5 % of the positive frame's force.
+  for (std::size_t i = 1; i < a.size(); ++i)
+    EXPECT_NEAR(f[i], 2 * a[i],
+                0.005 * (2 * a[i] + workflow::pillar_shear_force(strain, force, gauge, a[i])))
+        << a[i];
+  const toml::table root = toml::parse_file(out.string());
+  const auto* bars = root["bar_law"].as_array();
+  ASSERT_TRUE(bars && bars->size() == 1);
+  EXPECT_EQ((*bars->at(0).as_table())["name"].value<std::string>(), "pillar");
+  // Without the meso case's fabric: exit 2 naming the key.
+  fs::remove(pos / "case.toml");
+  std::ofstream(pos / "case.toml") << "[case]\nname = \"x\"\n";
+  const auto bad = run_cli({"calibrate", "macro", "--positive", pos.string(), "--negative",
+                            neg.string(), "--stitch-bars", "-o", out.string()});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.output.find("mesh.fabric"), std::string::npos) << bad.output;
+}
+
 TEST(CliMacroCalibration, BadInputExits2NamingFileAndKey) {
   const auto good = fake_frame_run("mcb_good", 30, [](double g) { return g; });
   const auto broken = fake_frame_run(
@@ -203,37 +251,40 @@ TEST(CliVerificationMacroChain, PictureFramesReproduceTheMesoCurvesWithin10Perce
   }
 }
 
-// The macro bias extension (cases/drape/macro/bias_extension_<sign>.toml): centre shear from its
-// four probes on the fibre lines through the centre (90 deg - the angle of their chords).
-void check_bias_extension(const std::string& sign) {
-  const bool pos = sign == "positive";
-  const std::string ax = pos ? "x" : "y";
-  const double cx = pos ? 0.135 : 0.05, cy = pos ? 0.05 : 0.135, d = 0.0025;
-  const fs::path out = fresh_dir("macro_bias_" + sign);
-  const auto r = run_cli(
-      {"-q", "run", (kSource / ("cases/drape/macro/bias_extension_" + sign + ".toml")).string(),
-       "-o", out.string(), "--set", "output.frames=none", "--set", "output.figures=false"});
-  ASSERT_EQ(r.code, 0) << r.output;
-  const History h = read_history(out / "history.csv");
-  const auto jd = h.column("grip_displacement_" + ax + "_m"),
-             jf = h.column("pull_reaction_" + ax + "_N");
-  ASSERT_LT(jd, h.columns.size());
-  ASSERT_LT(jf, h.columns.size());
-  auto point = [&](const std::vector<double>& row, const std::string& p, double ox, double oy) {
-    return std::array<double, 2>{cx + ox + row[h.column(p + "_displacement_x_m")],
-                                 cy + oy + row[h.column(p + "_displacement_y_m")]};
-  };
-  auto shear = [&](const std::vector<double>& row) {
+// A macro bias-extension run (case `case_rel` under the source tree): force and centre shear at a
+// grip extension, centre shear from its four probes on the fibre lines through the centre (90 deg
+// - the angle of their chords).
+struct MacroBiasRun {
+  History h;
+  std::string sign;
+  std::size_t jd = 0, jf = 0;
+  double cx = 0, cy = 0;
+  std::array<double, 2> point(const std::vector<double>& row, const std::string& p, double ox,
+                              double oy) const {
+    return {cx + ox + row[h.column(p + "_displacement_x_m")],
+            cy + oy + row[h.column(p + "_displacement_y_m")]};
+  }
+  double shear(const std::vector<double>& row) const {
+    const double d = 0.0025;
     const auto pp = point(row, "c_pp", d, d), mm = point(row, "c_mm", -d, -d);
     const auto pm = point(row, "c_pm", d, -d), mp = point(row, "c_mp", -d, d);
     const double a0 = pp[0] - mm[0], a1 = pp[1] - mm[1], b0 = pm[0] - mp[0], b1 = pm[1] - mp[1];
     const double c = (a0 * b0 + a1 * b1) / std::hypot(a0, a1) / std::hypot(b0, b1);
     return std::abs(90 - 180 / M_PI * std::acos(c));
-  };
-  const Reference ref = case_reference("drape", "macro_chain_bias_" + sign);
-  // The macro coupon's force at a centre shear angle (linear between its history rows; the centre
-  // shears monotonically).
-  auto macro_force_at_angle = [&](double g) {
+  }
+  // {force N, centre shear deg} at extension mm (linear between the history rows); NaN past the
+  // end.
+  std::array<double, 2> at_extension(double mm) const {
+    std::size_t k = 1;
+    while (k < h.rows.size() && std::abs(h.rows[k][jd]) < 1e-3 * mm) ++k;
+    if (k >= h.rows.size()) return {NAN, NAN};
+    const double w = (1e-3 * mm - std::abs(h.rows[k - 1][jd])) /
+                     (std::abs(h.rows[k][jd]) - std::abs(h.rows[k - 1][jd]));
+    return {std::abs(h.rows[k - 1][jf] + w * (h.rows[k][jf] - h.rows[k - 1][jf])),
+            shear(h.rows[k - 1]) + w * (shear(h.rows[k]) - shear(h.rows[k - 1]))};
+  }
+  // The force at a centre shear angle (linear between rows; the centre shears monotonically).
+  double force_at_angle(double g) const {
     double g0 = 0, f0 = 0;
     for (std::size_t k = 1; k < h.rows.size(); ++k) {
       const double g1 = shear(h.rows[k]), f1 = std::abs(h.rows[k][jf]);
@@ -241,16 +292,39 @@ void check_bias_extension(const std::string& sign) {
       if (g1 > g0) g0 = g1, f0 = f1;
     }
     return std::numeric_limits<double>::quiet_NaN();  // the macro centre does not get there
-  };
+  }
+};
+
+MacroBiasRun run_macro_bias(const std::string& case_rel, const std::string& sign) {
+  MacroBiasRun r;
+  r.sign = sign;
+  const bool pos = sign == "positive";
+  const std::string ax = pos ? "x" : "y";
+  r.cx = pos ? 0.135 : 0.05, r.cy = pos ? 0.05 : 0.135;
+  const fs::path out = fresh_dir("macro_bias_" + sign);
+  const auto c = run_cli({"-q", "run", (kSource / case_rel).string(), "-o", out.string(), "--set",
+                          "output.frames=none", "--set", "output.figures=false"});
+  EXPECT_EQ(c.code, 0) << c.output;
+  if (c.code != 0) return r;
+  r.h = read_history(out / "history.csv");
+  r.jd = r.h.column("grip_displacement_" + ax + "_m"),
+  r.jf = r.h.column("pull_reaction_" + ax + "_N");
+  EXPECT_LT(r.jd, r.h.columns.size());
+  EXPECT_LT(r.jf, r.h.columns.size());
+  return r;
+}
+
+// The classic macro bias extension (cases/drape/macro/bias_extension_<sign>.toml).
+void check_bias_extension(const std::string& sign) {
+  const bool pos = sign == "positive";
+  const MacroBiasRun run =
+      run_macro_bias("cases/drape/macro/bias_extension_" + sign + ".toml", sign);
+  ASSERT_FALSE(run.h.rows.empty());
+  const Reference ref = case_reference("drape", "macro_chain_bias_" + sign);
   for (std::size_t i = 0; i < ref.rows.size(); ++i) {
     const double mm = ref.number(i, "extension_mm");
-    std::size_t k = 1;
-    while (k < h.rows.size() && std::abs(h.rows[k][jd]) < 1e-3 * mm) ++k;
-    ASSERT_LT(k, h.rows.size()) << "the run did not reach " << mm << " mm";
-    const double w = (1e-3 * mm - std::abs(h.rows[k - 1][jd])) /
-                     (std::abs(h.rows[k][jd]) - std::abs(h.rows[k - 1][jd]));
-    const double force = std::abs(h.rows[k - 1][jf] + w * (h.rows[k][jf] - h.rows[k - 1][jf]));
-    const double g = shear(h.rows[k - 1]) + w * (shear(h.rows[k]) - shear(h.rows[k - 1]));
+    const auto [force, g] = run.at_extension(mm);
+    ASSERT_FALSE(std::isnan(force)) << "the run did not reach " << mm << " mm";
     EXPECT_NEAR(force, ref.number(i, "macro_force_N"), 0.10 * ref.number(i, "macro_force_N"))
         << sign << " at " << mm << " mm";
     EXPECT_NEAR(g, ref.number(i, "macro_centre_shear_deg"), 1.0) << sign << " at " << mm << " mm";
@@ -261,7 +335,7 @@ void check_bias_extension(const std::string& sign) {
     // the macro force at the meso centre's angle, within the measured agreement.
     const double g_meso = ref.number(i, "meso_centre_shear_deg"),
                  f_meso = ref.number(i, "meso_force_N");
-    const double f_macro = macro_force_at_angle(g_meso), band = ref.number(i, "meso_band");
+    const double f_macro = run.force_at_angle(g_meso), band = ref.number(i, "meso_band");
     if (!std::isnan(band)) {
       EXPECT_NEAR(f_macro, f_meso, band * f_meso)
           << sign << " at the meso centre's " << g_meso << " deg (" << mm << " mm)";
@@ -274,11 +348,151 @@ void check_bias_extension(const std::string& sign) {
   }
 }
 
+// The stitched macro bias extension (cases/drape/macro/stitched/bias_extension_<sign>.toml)
+// against the meso coupon as the paper compares bias tests (Figs. 14, 15): force and centre shear
+// at each extension, within the reference's bands.
+void check_stitched_bias_extension(const std::string& sign) {
+  const MacroBiasRun run =
+      run_macro_bias("cases/drape/macro/stitched/bias_extension_" + sign + ".toml", sign);
+  ASSERT_FALSE(run.h.rows.empty());
+  const Reference ref = case_reference("drape", "macro_chain_stitched_bias_" + sign);
+  for (std::size_t i = 0; i < ref.rows.size(); ++i) {
+    const double mm = ref.number(i, "extension_mm");
+    const auto [force, g] = run.at_extension(mm);
+    ASSERT_FALSE(std::isnan(force)) << "the run did not reach " << mm << " mm";
+    EXPECT_NEAR(force, ref.number(i, "macro_force_N"), 0.05 * ref.number(i, "macro_force_N"))
+        << sign << " at " << mm << " mm";
+    EXPECT_NEAR(g, ref.number(i, "macro_centre_shear_deg"), 1.0) << sign << " at " << mm << " mm";
+    const double f_meso = ref.number(i, "meso_force_N"),
+                 g_meso = ref.number(i, "meso_centre_shear_deg");
+    const double band = ref.number(i, "meso_force_band"),
+                 gband = ref.number(i, "meso_shear_band_deg");
+    if (!std::isnan(band)) {
+      EXPECT_NEAR(force, f_meso, band * f_meso)
+          << sign << " at " << mm << " mm, against the meso coupon";
+      EXPECT_NEAR(g, g_meso, gband) << sign << " at " << mm << " mm, against the meso coupon";
+    }
+    std::printf("stitched %s %2.0f mm: macro %.3g N, %.1f deg | meso %.3g N, %.1f deg (%+.1f %%)\n",
+                sign.c_str(), mm, force, g, f_meso, g_meso, 100 * (force / f_meso - 1));
+  }
+}
+
 TEST(CliVerificationMacroChain, BiasExtensionPositiveKeepsItsForceAndFollowsTheMesoCoupon) {
   check_bias_extension("positive");
 }
 TEST(CliVerificationMacroChain, BiasExtensionNegativeKeepsItsForceAndFollowsTheMesoCoupon) {
   check_bias_extension("negative");
+}
+
+TEST(CliVerificationMacroChain, StitchedBiasExtensionPositiveFollowsTheMesoCoupon) {
+  check_stitched_bias_extension("positive");
+}
+TEST(CliVerificationMacroChain, StitchedBiasExtensionNegativeFollowsTheMesoCouponTo30mm) {
+  check_stitched_bias_extension("negative");
+}
+
+// The stitched macro frames: the shells' tows' curves and the pillars' bars together give the meso
+// frames back (the acceptance's 10 %, measured within 1 %): the pillars' bars, sewn on and held at
+// their ends by the frame, carry their Eq. 4-5 force.
+TEST(CliVerificationMacroChain, StitchedPictureFramesReproduceTheMesoCurvesWithin10PercentTo40Deg) {
+  const Reference ref = case_reference("drape", "macro_chain_frame");
+  for (const auto& [cs, column] : {std::pair{"picture_frame_positive", "positive_fitted"},
+                                   {"picture_frame_negative", "negative_fitted"}}) {
+    const fs::path out = fresh_dir(std::string("macro_stitched_") + cs);
+    const auto r = run_cli(
+        {"-q", "run",
+         (kSource / "cases/drape/macro/stitched" / (std::string(cs) + ".toml")).string(), "-o",
+         out.string(), "--set", "output.frames=none", "--set", "output.figures=false"});
+    ASSERT_EQ(r.code, 0) << r.output;
+    const History h = read_history(out / "history.csv");
+    int checked = 0;
+    for (std::size_t i = 0; i < ref.rows.size(); ++i) {
+      const double g = ref.number(i, "shear_angle_deg");
+      if (g < 5 || g > 40) continue;
+      const double meso = ref.number(i, column), macro = frame_force_at(h, g);
+      EXPECT_NEAR(macro, meso, 0.10 * meso) << cs << " at " << g << " deg";
+      EXPECT_NEAR(macro, meso, 0.02 * meso + 0.2)
+          << cs << " at " << g << " deg (measured within 1 %)";
+      ++checked;
+    }
+    EXPECT_EQ(checked, 15);
+  }
+}
+
+// A line of 17 stitch nodes (2.5 mm apart, each with a sliding force of 0.05 N: gauge and stitch
+// length equal to the line's spacings) sewn onto clamped shells and pulled out by its end at
+// 50 mm/s: once every node slides the pull is the sum of their sliding forces, 0.85 N (Coulomb),
+// and the friction work grows at that force times the speed.
+TEST(CliVerificationShellStitch, LinePulledThroughClampedFabricCarriesTheSumOfItsSlidingForces) {
+  const fs::path dir = fresh_dir("shell_stitch_pull");
+  fs::create_directories(dir);
+  std::ofstream(dir / "pull.toml") << R"([case]
+name = "stitch_pull_through"
+[[mesh.plate]]
+part = "fabric"
+size = [0.04, 0.005]
+divisions = [16, 3]
+[[mesh.shell_stitch]]
+name = "stitch"
+part = "fabric"
+direction = [1.0, 0.0, 0.0]
+law = "yarn"
+gauge = 0.005
+stitch_length = 0.0025
+line_spacing = 0.005
+point_spacing = 0.0025
+sliding_force = 0.05
+[[material]]
+name = "steel"
+type = "elastic_isotropic"
+density = 7850.0
+youngs_modulus = 200e9
+poisson_ratio = 0.3
+[[bar_law]]
+name = "yarn"
+type = "tabulated"
+tension_only = true
+linear_density = 1e-3
+strain = [0.0, 0.1]
+force = [0.0, 100.0]
+[[part]]
+name = "fabric"
+material = "steel"
+thickness = 0.001
+[[boundary.fixed]]
+name = "fabric"
+nodes = { part = "fabric", all = true }
+rotations = ["x", "y", "z"]
+[[boundary.velocity]]
+name = "pull"
+nodes = { box_min = [0.0399, 0.0024, -1.0], box_max = [0.0401, 0.0026, 1.0] }
+velocity = [0.05, 0.0, 0.0]
+dofs = ["x", "y", "z"]
+ramp_time = 0.002
+[time]
+end_time = 0.02
+history_interval = 2e-4
+[output]
+frames = "none"
+figures = false
+)";
+  const auto r = run_cli({"-q", "run", (dir / "pull.toml").string(), "-o", (dir / "out").string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const History h = read_history(dir / "out" / "history.csv");
+  const auto jt = h.column("time"), jf = h.column("pull_reaction_x_N"),
+             jw = h.column("friction_energy_J"), je = h.column("energy_balance_error");
+  double sum = 0, w0 = NAN, t0 = NAN, w1 = 0, t1 = 0;
+  int n = 0;
+  for (const auto& row : h.rows) {
+    if (row[jt] < 0.01 - 1e-9) continue;
+    sum += std::abs(row[jf]), ++n;
+    if (std::isnan(w0)) w0 = row[jw], t0 = row[jt];
+    w1 = row[jw], t1 = row[jt];
+    EXPECT_LT(std::abs(row[je]), 0.01);
+  }
+  ASSERT_GT(n, 10);
+  EXPECT_NEAR(sum / n, 17 * 0.05, 0.02 * 0.85) << "mean pull over 10-20 ms";
+  EXPECT_NEAR((w1 - w0) / (t1 - t0), 0.85 * 0.05, 0.02 * 0.85 * 0.05) << "friction power";
 }
 
 }  // namespace
