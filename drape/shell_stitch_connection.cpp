@@ -45,6 +45,7 @@ void StitchToShellConnection::add_forces(const double* x, const double*, const d
                                          double* f) {
   n_sliding_ = 0;
   for (std::size_t i = 0; i < links_.size(); ++i) {
+    if (!mine_.empty() && !mine_[i]) continue;  // another rank's
     const auto& l = links_[i];
     const auto a = 3 * static_cast<std::size_t>(l.stitch_node);
     // The anchor: the material point of the host a slip s along the line from the sewn point;
@@ -80,6 +81,19 @@ void StitchToShellConnection::add_forces(const double* x, const double*, const d
       for (int d = 0; d < 3; ++d) f[h + d] -= w[k] * fk[d];
     }
   }
+}
+
+bool StitchToShellConnection::nodes_to_read(const std::uint8_t* owned, const double*, double,
+                                            std::vector<std::int32_t>& out) const {
+  for (const auto& l : links_)
+    if (owned[static_cast<std::size_t>(l.stitch_node)]) out.insert(out.end(), l.host.begin(), l.host.end());
+  return true;
+}
+
+void StitchToShellConnection::restrict_to_rank(const std::uint8_t* owned, const std::uint8_t*) {
+  mine_.assign(links_.size(), 0);
+  for (std::size_t i = 0; i < links_.size(); ++i)
+    mine_[i] = owned[static_cast<std::size_t>(links_[i].stitch_node)];
 }
 
 void StitchToShellConnection::save_state(fem::CheckpointWriter& w) const {

@@ -35,6 +35,10 @@ class StitchToShellConnection final : public fem::ContactAlgorithm {
                   double* f_contact) override;
   double friction_dissipation() const override { return dissipated_; }
   std::int64_t active_contacts() const override { return n_sliding_; }
+  /// Several ranks: a link is computed where its stitch node is owned; it reads its host's nodes.
+  bool nodes_to_read(const std::uint8_t* owned, const double* x0, double halo,
+                     std::vector<std::int32_t>& out) const override;
+  void restrict_to_rank(const std::uint8_t* owned, const std::uint8_t* readable) override;
   void save_state(fem::CheckpointWriter& w) const override;
   void load_state(fem::CheckpointReader& r) override;
 
@@ -53,6 +57,7 @@ class StitchToShellConnection final : public fem::ContactAlgorithm {
   ShellStitchSliderSettings s_;
   std::vector<ShellStitchLink> links_;
   std::vector<double> k_, slip_, slip_len_, force_;
+  std::vector<std::uint8_t> mine_;  // several ranks: [n] 1 where this rank computes the link
   double dissipated_ = 0;
   std::int64_t n_sliding_ = 0;
 };
