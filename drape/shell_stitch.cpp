@@ -126,18 +126,23 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
   std::size_t n_spacings = 0;
   for (std::size_t l = 0; l < out.n_lines; ++l) {
     const double c0 = cmin + (static_cast<double>(l) + 0.5) * out.line_spacing;
-    std::vector<std::pair<double, double>> iv;
-    for (const auto& q : pq) {
+    struct Crossing {
       double a, b;
-      if (clip_line(q, c0, a, b)) iv.emplace_back(a, b);
+      std::size_t quad;
+      bool operator<(const Crossing& o) const { return a < o.a; }
+    };
+    std::vector<Crossing> iv;  // the quadrilaterals the line crosses and where
+    for (std::size_t qi = 0; qi < pq.size(); ++qi) {
+      double a, b;
+      if (clip_line(pq[qi], c0, a, b)) iv.push_back({a, b, qi});
     }
     std::sort(iv.begin(), iv.end());
     std::vector<std::pair<double, double>> runs;
-    for (const auto& [a, b] : iv)
-      if (!runs.empty() && a <= runs.back().second + tol)
-        runs.back().second = std::max(runs.back().second, b);
+    for (const auto& cr : iv)
+      if (!runs.empty() && cr.a <= runs.back().second + tol)
+        runs.back().second = std::max(runs.back().second, cr.b);
       else
-        runs.emplace_back(a, b);
+        runs.emplace_back(cr.a, cr.b);
     for (const auto& [a, b] : runs) {
       const double len = b - a;
       if (len <= tol) continue;
@@ -147,7 +152,11 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
         const double s = a + len * i / np;
         ShellStitchLink link;
         bool found = false;
-        for (const auto& q : pq) {
+        // Only the quadrilaterals whose crossing holds s (sorted by their start).
+        const auto last = std::upper_bound(iv.begin(), iv.end(), Crossing{s + tol, 0, 0});
+        for (auto it = iv.begin(); it != last; ++it) {
+          if (it->b < s - tol) continue;
+          const PlaneQuad& q = pq[it->quad];
           double xi, eta;
           std::array<double, 2> dxi{};
           if (!inverse_bilinear(q, s, c0, xi, eta, dxi)) continue;
