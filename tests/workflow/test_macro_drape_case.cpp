@@ -85,8 +85,8 @@ TEST(CliRegressionMacroDrape, StitchedModelShowsTheShearBias) {
   EXPECT_NEAR(q[2], q[0], 1.0);
   EXPECT_NEAR(q[3], q[1], 1.0);
   EXPECT_GT(q[1] - q[0], 10.0) << "no shear bias";
-  // Measured (5 December 2026): 11.02 / 29.45 / 11.01 / 29.45 deg (default shells: 11.0 / 29.5 /
-  // 11.0 / 29.5), 22 s.
+  // Measured (5 December 2026): 10.98 / 29.42 / 10.98 / 29.42 deg in 5 s (default shells: 11.09 /
+  // 29.42 / 11.09 / 29.42).
   std::printf("stitched macro drape, coarse: q1..q4 %.2f %.2f %.2f %.2f deg\n", q[0], q[1], q[2],
               q[3]);
   fs::remove_all(out);
