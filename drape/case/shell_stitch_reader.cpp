@@ -1,9 +1,12 @@
 // [[mesh.shell_stitch]]: the stitch of a macro fabric as bars sewn onto its shells.
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "drape/case/drape_case.hpp"
 #include "drape/fabric.hpp"
 #include "drape/shell_stitch_connection.hpp"
+#include "fem/case/model_size.hpp"
 #include "fem/errors.hpp"
 
 namespace ncfsim::drape {
@@ -37,6 +40,25 @@ std::vector<ShellStitchEntry> read_shell_stitches(fem::CaseReadContext& ctx, con
     e.slider.sliding_force = t.number("sliding_force", 0.4, Range::positive());
     e.slider.tie_ends = t.boolean("tie_ends", false);
     e.added_mass_per_area = t.number("added_mass_per_area", 0.0, Range::non_negative());
+    {  // before sewing: spacings too fine for the machine are bad input
+      const fem::ElementSet& quads = ctx.model.mesh.elements(fem::ElementKind::Quad4);
+      std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+      for (std::size_t q = 0; q < quads.size(); ++q)
+        if (quads.part[q] == spec.shell_part)
+          for (auto nd : quads.nodes(q))
+            for (int k = 0; k < 3; ++k) {
+              const double c = ctx.model.mesh.coords[3 * static_cast<std::size_t>(nd) + k];
+              lo[k] = std::min(lo[k], c), hi[k] = std::max(hi[k], c);
+            }
+      const double diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+      const double n = (diag / spec.line_spacing + 1) * (diag / spec.point_spacing + 1);
+      const fem::Mesh& mesh = ctx.model.mesh;
+      fem::require_model_fits(
+          t.file().string(), t.key_path("line_spacing") + ", " + t.key_path("point_spacing"),
+          static_cast<double>(mesh.n_nodes()) + n,
+          static_cast<double>(mesh.elements(fem::ElementKind::Hex8).size()),
+          static_cast<double>(mesh.elements(fem::ElementKind::Bar2).size()) + n);
+    }
     const int bar_part = ctx.model.mesh.add_part(e.name);
     ctx.part_kind[e.name] = fem::PartKind::Bar;
     ctx.generated_parts[e.name] = "[[mesh.shell_stitch]]";

@@ -495,5 +495,24 @@ figures = false
   EXPECT_NEAR((w1 - w0) / (t1 - t0), 0.85 * 0.05, 0.02 * 0.85 * 0.05) << "friction power";
 }
 
+// Bad [[mesh.shell_stitch]] input: exit 2 naming the file and the key (and never a run that
+// allocates a line per nanometre).
+TEST(CliShellStitch, BadInputExits2NamingTheKey) {
+  const std::string c =
+      (kSource / "cases/drape/macro/stitched/bias_extension_positive.toml").string();
+  for (const auto& [set, key] :
+       {std::pair{"mesh.shell_stitch[0].line_spacing=1e-9", "mesh.shell_stitch[0].line_spacing"},
+        {"mesh.shell_stitch[0].law='nothing'", "mesh.shell_stitch[0].law"},
+        {"mesh.shell_stitch[0].part='nothing'", "mesh.shell_stitch[0].part"},
+        {"mesh.shell_stitch[0].direction=[0.0, 0.0, 1.0]", "mesh.shell_stitch[0].direction"},
+        {"mesh.shell_stitch[0].sliding_force=0", "mesh.shell_stitch[0].sliding_force"},
+        {"mesh.shell_stitch[0].name='fabric'", "mesh.shell_stitch[0].name"}}) {
+    const auto r = run_cli({"check", c, "--set", set});
+    EXPECT_EQ(r.code, 2) << set << ": " << r.output;
+    EXPECT_NE(r.output.find(key), std::string::npos) << set << ": " << r.output;
+    EXPECT_NE(r.output.find("bias_extension_positive.toml"), std::string::npos) << r.output;
+  }
+}
+
 }  // namespace
 }  // namespace ncfsim::test
