@@ -122,8 +122,6 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
   out.pillar_share = out.line_spacing / spec.gauge;
   const double tol = 1e-9 * size;
   fem::ElementSet& bars = mesh.elements(fem::ElementKind::Bar2);
-  double spacing_sum = 0;
-  std::size_t n_spacings = 0;
   for (std::size_t l = 0; l < out.n_lines; ++l) {
     const double c0 = cmin + (static_cast<double>(l) + 0.5) * out.line_spacing;
     struct Crossing {
@@ -147,7 +145,6 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
       const double len = b - a;
       if (len <= tol) continue;
       const int np = std::max(1, static_cast<int>(std::lround(len / spec.point_spacing)));
-      spacing_sum += len, n_spacings += static_cast<std::size_t>(np);
       for (int i = 0; i <= np; ++i) {
         const double s = a + len * i / np;
         ShellStitchLink link;
@@ -177,6 +174,9 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
         V p{0, 0, 0};
         for (int k = 0; k < 4; ++k)
           for (int d = 0; d < 3; ++d) p[d] += link.weight[k] * X(link.host[k])[d];
+        link.penetrations =
+            out.pillar_share * (i == 0 || i == np ? 0.5 : 1.0) * (len / np) / spec.stitch_length;
+        out.penetrations += link.penetrations;
         link.stitch_node = static_cast<std::int32_t>(mesh.n_nodes());
         for (double v : p) mesh.coords.push_back(v);
         if (i > 0) {
@@ -190,9 +190,6 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
     }
   }
   if (out.links.empty()) throw InputError(file, key, "no stitch line crosses the part");
-  const double mean_spacing =
-      spacing_sum / static_cast<double>(std::max<std::size_t>(1, n_spacings));
-  out.penetration_share = out.pillar_share * mean_spacing / spec.stitch_length;
   return out;
 }
 

@@ -34,6 +34,9 @@ struct ShellStitchLink {
   // shell's size).
   std::array<double, 4> slide{};
   std::int32_t prev = -1, next = -1;  // neighbouring stitch nodes on the line (-1: line end)
+  // The fabric's penetrations this node stands for: pillar_share x its length of line (half a
+  // step at a line's end) / stitch_length. Its slider slides at this times the force of one.
+  double penetrations = 0;
 };
 
 struct ShellStitchModel {
@@ -41,7 +44,7 @@ struct ShellStitchModel {
   std::size_t n_lines = 0;
   double line_spacing = 0;       // m, as laid (the part's width over the number of lines)
   double pillar_share = 0;       // pillars per line: line_spacing / gauge (scales the bar law)
-  double penetration_share = 0;  // penetrations per stitch node: pillar_share * spacing / length
+  double penetrations = 0;  // sum over the links: the fabric's penetrations the lines stand for
 };
 
 /// Lays the lines over the shell part (flat at set-up) and appends their nodes and bars (part

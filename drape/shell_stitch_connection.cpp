@@ -58,16 +58,16 @@ void StitchToShellConnection::add_forces(const double* x, const double*, const d
     }
     double u[3];
     for (int d = 0; d < 3; ++d) u[d] = x[a + d] - p[d];
-    const bool end = l.prev < 0 || l.next < 0;
     const double tl = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    if (!(end && s_.tie_ends) && tl > 0) {
+    if (tl > 0) {
       const double ut = (u[0] * t[0] + u[1] * t[1] + u[2] * t[2]) / tl;
-      const double limit = s_.sliding_force / k_[i];
+      const double fs = s_.sliding_force * l.penetrations;
+      const double limit = fs / k_[i];
       if (std::abs(ut) > limit) {
         const double ds = ut - std::copysign(limit, ut);  // m, in the current configuration
         slip_[i] += ds / tl;
         slip_len_[i] += std::abs(ds);
-        dissipated_ += s_.sliding_force * std::abs(ds);
+        dissipated_ += fs * std::abs(ds);
         for (int k = 0; k < 4; ++k) w[k] = l.weight[k] + slip_[i] * l.slide[k];
         for (int d = 0; d < 3; ++d) u[d] -= ds * t[d] / tl;
         ++n_sliding_;

@@ -6,8 +6,8 @@
 // as a reference length along the line and moves the spring's anchor to the material point it
 // reaches (weights linear in the slip, so the forces on the host's nodes are those of a spring
 // between two points, with no follower terms). Across the line and out of the plane it stays
-// elastic: the stitch stays sewn to its row of the fabric. The ends of a line may be
-// tied (no slip: held by a clamp or a frame, as the meso frame holds its stitch ends).
+// elastic: the stitch stays sewn to its row of the fabric. A clamp or a frame holds a line's end
+// nodes directly (node selector shell_stitch_ends), not through their sliders.
 // Implemented as a contact of the engine: forces into the contact forces (they sum to zero),
 // the slip work into friction_dissipation.
 #include <cstdint>
@@ -21,7 +21,6 @@ namespace ncfsim::drape {
 
 struct ShellStitchSliderSettings {
   double sliding_force = 0.1;  // N per stitch node (> 0; the reader scales it by the node's share)
-  bool tie_ends = false;       // the lines' end nodes do not slide
   double stiffness_scale = 0.1;  // k = scale * min(m_stitch, m_point) / dt^2: never lowers the step
 };
 

@@ -47,7 +47,7 @@ struct ShellStitchEntry {
   std::string name, path, law;
   int bar_part = -1;
   ShellStitchModel model;
-  ShellStitchSliderSettings slider;  // sliding_force per penetration of the fabric (as read)
+  ShellStitchSliderSettings slider;  // sliding_force per penetration of the fabric
   double added_mass_per_area = 0;    // kg/m^2 carried by the stitch nodes on top of the yarn's
 };
 

@@ -38,7 +38,6 @@ std::vector<ShellStitchEntry> read_shell_stitches(fem::CaseReadContext& ctx, con
     spec.point_spacing = t.number("point_spacing", spec.stitch_length, Range::positive());
     e.law = t.string("law");
     e.slider.sliding_force = t.number("sliding_force", 0.4, Range::positive());
-    e.slider.tie_ends = t.boolean("tie_ends", false);
     e.added_mass_per_area = t.number("added_mass_per_area", 0.0, Range::non_negative());
     {  // before sewing: spacings too fine for the machine are bad input
       const fem::ElementSet& quads = ctx.model.mesh.elements(fem::ElementKind::Quad4);
@@ -106,10 +105,8 @@ void assign_shell_stitch_parts(fem::CaseReadContext& ctx,
     auto& pp = ctx.model.parts[static_cast<std::size_t>(e.bar_part)];
     pp.bar_law = static_cast<int>(ctx.model.bar_laws.size()) - 1;
     ctx.part_defined[static_cast<std::size_t>(e.bar_part)] = 1;
-    ShellStitchSliderSettings s = e.slider;
-    s.sliding_force *= e.model.penetration_share;  // per stitch node: its share of penetrations
     ctx.model.contacts.push_back(
-        std::make_unique<StitchToShellConnection>(e.name + "_slider", e.model.links, s));
+        std::make_unique<StitchToShellConnection>(e.name + "_slider", e.model.links, e.slider));
   }
 }
 

@@ -70,7 +70,9 @@ TEST(ShellStitch, LinesAlongXCoverThePlateAndSitOnTheirShells) {
   EXPECT_EQ(st.n_lines, 4u);  // 10 mm / 2.5 mm, at y = 1.25, 3.75, 6.25, 8.75 mm
   EXPECT_NEAR(st.line_spacing, 2.5e-3, 1e-15);
   EXPECT_NEAR(st.pillar_share, 0.5, 1e-12);        // 2.5 mm of 5 mm gauge
-  EXPECT_NEAR(st.penetration_share, 0.25, 1e-12);  // and 2.5 mm of 5 mm stitch length
+  // Each interior node stands for 2.5 / 5 of a line of pillars and 2.5 / 5 of a stitch length;
+  // the lines' ends for half that: 4 lines of 20 mm, 0.5 pillar each, a penetration per 5 mm.
+  EXPECT_NEAR(st.penetrations, 4 * 0.5 * 20.0 / 5.0, 1e-12);
   ASSERT_EQ(st.links.size(), 4u * 9);
   EXPECT_EQ(m.n_nodes(), n0 + st.links.size());
   EXPECT_EQ(m.elements(fem::ElementKind::Bar2).size(), 4u * 8);
@@ -124,7 +126,8 @@ TEST(ShellStitch, CurvedPartOrNormalDirectionIsBadInput) {
 }
 
 // One line of three stitch nodes at y = 0.5 mm over two 1 mm shells, every mass 1e-6 kg, step
-// 1e-6 s: k = 0.1 m / dt^2 = 1e5 N/m, sliding force 0.01 N (slides past 0.1 um).
+// 1e-6 s: k = 0.1 m / dt^2 = 1e5 N/m; gauge and stitch length 1 mm, so the middle node stands for
+// one penetration: sliding force 0.01 N (slides past 0.1 um).
 struct OneLine {
   fem::Mesh mesh = plate(2e-3, 1e-3, 2, 1);
   drape::ShellStitchModel st;
@@ -132,7 +135,9 @@ struct OneLine {
   std::unique_ptr<drape::StitchToShellConnection> c;
   std::size_t mid = 0;  // the middle link
   OneLine() {
-    st = drape::sew_shell_stitch(mesh, spec({1, 0, 0}, 1e-3, 1e-3), 1, "f.toml", "k");
+    auto sp = spec({1, 0, 0}, 1e-3, 1e-3);
+    sp.gauge = sp.stitch_length = 1e-3;
+    st = drape::sew_shell_stitch(mesh, sp, 1, "f.toml", "k");
     x0 = mesh.coords;
     mass.assign(x0.size(), 1e-6);
     drape::ShellStitchSliderSettings s;
@@ -143,6 +148,7 @@ struct OneLine {
     c->initialise(setup);
     for (std::size_t i = 0; i < st.links.size(); ++i)
       if (st.links[i].prev >= 0 && st.links[i].next >= 0) mid = i;
+    EXPECT_NEAR(st.links[mid].penetrations, 1.0, 1e-12);
   }
   // Forces at positions x; checks that they sum to zero.
   std::vector<double> forces(const std::vector<double>& x) {
