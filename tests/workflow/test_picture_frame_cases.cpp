@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "tests/workflow/cli_test_support.hpp"
+#include "workflow/calibrate/calibrate_macro.hpp"
 
 namespace fs = std::filesystem;
 using namespace ncfsim::test;
@@ -103,22 +104,13 @@ std::pair<std::vector<double>, std::vector<double>> pillar_law() {
   return {strain, force};
 }
 
-// Normalised shear force (N/m) of the 'I' pillar stitches when they follow the frame exactly: the
-// wale lies along the diagonal that opens, so a pillar stretches by e = sqrt(2) cos(45 deg - g/2) -
-// 1 (paper Eq. 4-5) and carries T(e) (the case's tabulated stitch_I law, linear between its
-// points); pillars lie a gauge G apart, so their power per unit initial area is T(e) de/dg dg/dt /
-// G, and the frame's normalised force is that power per unit area over cos(g) dg/dt (the power of
-// F_sh L cos g dg/dt on an area L^2 cos g).
+// Normalised shear force (N/m) of the 'I' pillar stitches when they follow the frame exactly
+// (paper Eq. 4-5, workflow::pillar_shear_force: the law calibrate macro --stitch-bars uses), with
+// the case's tabulated stitch_I law; pillars a gauge apart: the tow pitch (3.22 + 0.10 mm) times
+// sqrt(2).
 double pillar_stitch_force(double g_deg) {
   static const auto [strain, force] = pillar_law();
-  const double gauge = 3.32e-3 * std::sqrt(2.0);  // m: tow pitch (3.22 + 0.10 mm) times sqrt(2)
-  const double g = g_deg * M_PI / 180, e = std::sqrt(2.0) * std::cos(M_PI / 4 - g / 2) - 1;
-  std::size_t k = 1;
-  while (k + 1 < strain.size() && e > strain[k]) ++k;
-  const double tension =
-      force[k - 1] + (force[k] - force[k - 1]) * (e - strain[k - 1]) / (strain[k] - strain[k - 1]);
-  const double de_dg = std::sqrt(2.0) / 2 * std::sin(M_PI / 4 - g / 2);
-  return tension * de_dg / gauge / std::cos(g);
+  return ncfsim::workflow::pillar_shear_force(strain, force, 3.32e-3 * std::sqrt(2.0), g_deg);
 }
 
 double force_at(const FrameRun& r, double g) {
