@@ -375,13 +375,18 @@ MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
     // The tows' share of the positive frame; held monotone (the pillars' force grows faster
     // than the frame's below a few degrees, where both are noise).
     double top = 0;
+    int held = 0;
     for (std::size_t i = 0; i < cal.positive.curve.angle_deg.size(); ++i) {
       double& f = cal.positive.curve.force[i];
       f -= pillar_shear_force(pillars.strain, pillars.force, pillars.gauge,
                               cal.positive.curve.angle_deg[i]);
+      if (f < top || f < 0) ++held;
       f = std::max({f, top, 0.0});
       top = f;
     }
+    if (held)
+      cal.notes.push_back(
+          fmt::format("positive, less the pillars: {} point(s) held at the running maximum", held));
   }
   if (o.symmetric) cal.symmetric = average_curves(cal.positive.curve, cal.negative.curve);
 
