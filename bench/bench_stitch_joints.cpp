@@ -5,12 +5,20 @@
 // rotation field so that every joint's tow axis has turned and some joints slide. Counter
 // ns_per_joint_cycle: time per (joint x cycle) of add_forces.
 //   bench_stitch_joints                  a 100 x 100 mm blanket, CI mesh (0) and default (1)
+// And the sliders that sew a macro fabric's stitch onto its shells (drape/shell_stitch_connection):
+// a 290 mm blank of 2.5 mm shells (the macro hemisphere's), a line per row of shells, a stitch node
+// per shell node along it, the same shear, turn and bulge, a third of the stitch nodes displaced
+// along their lines (they slide in the first call; the timed calls, at the same positions, find
+// every link sticking: the common case in a drape). Counter ns_per_link_cycle.
+//   BM_ShellStitchSliders/116            116 x 116 shells: 13 456 links
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <vector>
 
 #include "drape/fabric_generator.hpp"
+#include "drape/shell_stitch.hpp"
+#include "drape/shell_stitch_connection.hpp"
 #include "drape/stitch_connection.hpp"
 
 using namespace ncfsim;
@@ -57,7 +65,55 @@ void BM_StitchJoints(benchmark::State& state) {
       n, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
+void BM_ShellStitchSliders(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const double size = 0.29, h = size / n;
+  fem::Mesh mesh;
+  mesh.add_part("blank");
+  mesh.add_part("stitch");
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) mesh.coords.insert(mesh.coords.end(), {i * h, j * h, 0.0});
+  auto id = [&](int i, int j) { return static_cast<std::int32_t>(i + (n + 1) * j); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      mesh.elements(fem::ElementKind::Quad4)
+          .add({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)}, 0);
+  drape::ShellStitchSpec spec;
+  spec.shell_part = 0;
+  spec.gauge = spec.stitch_length = 4.7e-3;
+  spec.line_spacing = spec.point_spacing = h;
+  const drape::ShellStitchModel st = drape::sew_shell_stitch(mesh, spec, 1, "bench", "bench");
+  const std::size_t nn = mesh.n_nodes();
+  std::vector<double> mass(3 * nn, 1e-6), f(3 * nn, 0.0), x = mesh.coords;
+  for (std::size_t i = 0; i < nn; ++i) {
+    const double X = mesh.coords[3 * i], Y = mesh.coords[3 * i + 1];
+    const double c = std::cos(0.1), s = std::sin(0.1);
+    const double xs = X + 0.2 * Y;
+    x[3 * i] = c * xs - s * Y;
+    x[3 * i + 1] = s * xs + c * Y;
+    x[3 * i + 2] += 0.05 * size * std::sin(3.14159 * X / size) * std::sin(3.14159 * Y / size);
+  }
+  for (std::size_t k = 0; k < st.links.size(); k += 3)  // a third pulled along their line
+    x[3 * static_cast<std::size_t>(st.links[k].stitch_node)] += 1e-4;
+  drape::ShellStitchSliderSettings settings;
+  drape::StitchToShellConnection sliders("stitch_slider", st.links, settings);
+  const double dt = 1e-6;
+  fem::ContactSetup setup{&mesh, mesh.coords.data(), mass.data(), dt};
+  sliders.initialise(setup);
+  for (auto _ : state) {
+    sliders.add_forces(x.data(), nullptr, mass.data(), dt, f.data());
+    benchmark::DoNotOptimize(f.data());
+  }
+  const double links = static_cast<double>(sliders.size());
+  state.counters["links"] = links;
+  state.counters["sliding"] = static_cast<double>(sliders.active_contacts());
+  state.counters["ns_per_link_cycle"] = benchmark::Counter(
+      links, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 }  // namespace
+
+BENCHMARK(BM_ShellStitchSliders)->Arg(116)->Repetitions(3)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_StitchJoints)
     ->Args({100, 0})
