@@ -491,6 +491,27 @@ figures = false
   EXPECT_NEAR((w1 - w0) / (t1 - t0), 0.8 * 0.05, 0.02 * 0.8 * 0.05) << "friction power";
 }
 
+// The sliders' slips are in the checkpoint: the stitched positive coupon stopped at 6000 cycles
+// (18 ms, its sliders sliding) and resumed gives the uninterrupted run's history bit for bit.
+TEST(CliRegressionShellStitch, StitchedCouponResumesBitForBit) {
+  const std::string c =
+      (kSource / "cases/drape/macro/stitched/bias_extension_positive.toml").string();
+  const fs::path full = fresh_dir("stitch_resume_full"), part = fresh_dir("stitch_resume_part");
+  const std::vector<std::string> quiet = {"--set", "output.frames=none", "--set",
+                                          "output.figures=false"};
+  auto args = [&](const fs::path& out, std::vector<std::string> more) {
+    std::vector<std::string> a = {"-q", "run", c, "-o", out.string()};
+    a.insert(a.end(), quiet.begin(), quiet.end());
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  };
+  ASSERT_EQ(run_cli(args(full, {})).code, 0);
+  ASSERT_EQ(run_cli(args(part, {"--set", "time.max_cycles=6000"})).code, 1);  // stopped, kept
+  const auto r = run_cli(args(part, {"--resume"}));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(slurp(full / "history.csv"), slurp(part / "history.csv"));
+}
+
 // Bad [[mesh.shell_stitch]] input: exit 2 naming the file and the key (and never a run that
 // allocates a line per nanometre).
 TEST(CliShellStitch, BadInputExits2NamingTheKey) {
