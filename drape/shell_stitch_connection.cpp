@@ -1,5 +1,7 @@
 #include "drape/shell_stitch_connection.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -81,6 +83,19 @@ void StitchToShellConnection::add_forces(const double* x, const double*, const d
       for (int d = 0; d < 3; ++d) f[h + d] -= w[k] * fk[d];
     }
   }
+}
+
+std::size_t StitchToShellConnection::n_contact_nodes() const {
+  if (mine_.empty()) return links_.size();
+  return static_cast<std::size_t>(std::count(mine_.begin(), mine_.end(), std::uint8_t{1}));
+}
+
+std::string StitchToShellConnection::cost_details() const {
+  std::size_t lines = 0;
+  for (const auto& l : links_) lines += l.prev < 0 ? 1 : 0;
+  return std::to_string(links_.size()) + " stitch links on " + std::to_string(lines) + " lines, " +
+         std::to_string(n_sliding_) + " sliding in the last cycle, slip work " +
+         fmt::format("{:.4g}", dissipated_) + " J";
 }
 
 bool StitchToShellConnection::nodes_to_read(const std::uint8_t* owned, const double*, double,

@@ -34,6 +34,10 @@ class StitchToShellConnection final : public fem::ContactAlgorithm {
                   double* f_contact) override;
   double friction_dissipation() const override { return dissipated_; }
   std::int64_t active_contacts() const override { return n_sliding_; }
+  /// For the run's log: the links this rank computes, and in words the lines, the links sliding
+  /// in the last cycle and the slip work so far.
+  std::size_t n_contact_nodes() const override;
+  std::string cost_details() const override;
   /// Several ranks: a link is computed where its stitch node is owned; it reads its host's nodes.
   bool nodes_to_read(const std::uint8_t* owned, const double* x0, double halo,
                      std::vector<std::int32_t>& out) const override;
