@@ -25,6 +25,30 @@ using namespace ncfsim;
 
 namespace {
 
+// Positions x of the reference X (a square of side `size` in x-y): a shear of 0.2 rad and a turn
+// of 0.1 rad in the plane, and a bulge out of it: every tow axis and stitch line turns, the
+// connections load across and along.
+void sheared_turned_bulged(const std::vector<double>& X, double size, std::vector<double>& x) {
+  x = X;
+  const double c = std::cos(0.1), s = std::sin(0.1);
+  for (std::size_t i = 0; i < X.size() / 3; ++i) {
+    const double px = X[3 * i], py = X[3 * i + 1], xs = px + 0.2 * py;
+    x[3 * i] = c * xs - s * py;
+    x[3 * i + 1] = s * xs + c * py;
+    x[3 * i + 2] += 0.05 * size * std::sin(3.14159 * px / size) * std::sin(3.14159 * py / size);
+  }
+}
+
+// The timed loop: one add_forces per iteration at fixed positions.
+void time_add_forces(benchmark::State& state, fem::ContactAlgorithm& contact,
+                     const std::vector<double>& x, const std::vector<double>& mass, double dt,
+                     std::vector<double>& f) {
+  for (auto _ : state) {
+    contact.add_forces(x.data(), nullptr, mass.data(), dt, f.data());
+    benchmark::DoNotOptimize(f.data());
+  }
+}
+
 void BM_StitchJoints(benchmark::State& state) {
   const double size = 1e-3 * static_cast<double>(state.range(0));
   fem::Mesh mesh;
@@ -38,25 +62,13 @@ void BM_StitchJoints(benchmark::State& state) {
   const drape::FabricModel fm = drape::generate_blanket(mesh, fabric, blanket);
   const std::size_t nn = mesh.n_nodes();
   std::vector<double> mass(3 * nn, 1e-6), f(3 * nn, 0.0), x = mesh.coords;
-  // A shear of 0.2 rad and a turn of 0.1 rad in the plane, and a bulge out of it: every tow axis
-  // turns, the joints load across and along their tows.
-  for (std::size_t i = 0; i < nn; ++i) {
-    const double X = mesh.coords[3 * i], Y = mesh.coords[3 * i + 1];
-    const double c = std::cos(0.1), s = std::sin(0.1);
-    const double xs = X + 0.2 * Y;
-    x[3 * i] = c * xs - s * Y;
-    x[3 * i + 1] = s * xs + c * Y;
-    x[3 * i + 2] += 0.05 * size * std::sin(3.14159 * X / size) * std::sin(3.14159 * Y / size);
-  }
+  sheared_turned_bulged(mesh.coords, size, x);
   drape::StitchConnectionSettings settings;
   drape::StitchToTowConnection joints("stitch_tow", fm.connections, settings);
   const double dt = 1e-7;
   fem::ContactSetup setup{&mesh, mesh.coords.data(), mass.data(), dt};
   joints.initialise(setup);
-  for (auto _ : state) {
-    joints.add_forces(x.data(), nullptr, mass.data(), dt, f.data());
-    benchmark::DoNotOptimize(f.data());
-  }
+  time_add_forces(state, joints, x, mass, dt, f);
   const double n = static_cast<double>(joints.size());
   state.counters["joints"] = n;
   state.counters["hexahedra"] = static_cast<double>(mesh.n_elements(fem::ElementKind::Hex8));
@@ -85,14 +97,7 @@ void BM_ShellStitchSliders(benchmark::State& state) {
   const drape::ShellStitchModel st = drape::sew_shell_stitch(mesh, spec, 1, "bench", "bench");
   const std::size_t nn = mesh.n_nodes();
   std::vector<double> mass(3 * nn, 1e-6), f(3 * nn, 0.0), x = mesh.coords;
-  for (std::size_t i = 0; i < nn; ++i) {
-    const double X = mesh.coords[3 * i], Y = mesh.coords[3 * i + 1];
-    const double c = std::cos(0.1), s = std::sin(0.1);
-    const double xs = X + 0.2 * Y;
-    x[3 * i] = c * xs - s * Y;
-    x[3 * i + 1] = s * xs + c * Y;
-    x[3 * i + 2] += 0.05 * size * std::sin(3.14159 * X / size) * std::sin(3.14159 * Y / size);
-  }
+  sheared_turned_bulged(mesh.coords, size, x);
   for (std::size_t k = 0; k < st.links.size(); k += 3)  // a third pulled along their line
     x[3 * static_cast<std::size_t>(st.links[k].stitch_node)] += 1e-4;
   drape::ShellStitchSliderSettings settings;
@@ -100,10 +105,7 @@ void BM_ShellStitchSliders(benchmark::State& state) {
   const double dt = 1e-6;
   fem::ContactSetup setup{&mesh, mesh.coords.data(), mass.data(), dt};
   sliders.initialise(setup);
-  for (auto _ : state) {
-    sliders.add_forces(x.data(), nullptr, mass.data(), dt, f.data());
-    benchmark::DoNotOptimize(f.data());
-  }
+  time_add_forces(state, sliders, x, mass, dt, f);
   const double links = static_cast<double>(sliders.size());
   state.counters["links"] = links;
   state.counters["sliding"] = static_cast<double>(sliders.active_contacts());

@@ -25,8 +25,6 @@ void StitchToShellConnection::initialise(const fem::ContactSetup& setup) {
   const std::size_t n = links_.size(), nn = setup.mesh->n_nodes();
   k_.assign(n, 0.0);
   slip_.assign(n, 0.0);
-  slip_len_.assign(n, 0.0);
-  force_.assign(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     const auto& l = links_[i];
     for (auto nd : l.host)
@@ -68,7 +66,6 @@ void StitchToShellConnection::add_forces(const double* x, const double*, const d
       if (std::abs(ut) > limit) {
         const double ds = ut - std::copysign(limit, ut);  // m, in the current configuration
         slip_[i] += ds / tl;
-        slip_len_[i] += std::abs(ds);
         dissipated_ += fs * std::abs(ds);
         for (int k = 0; k < 4; ++k) w[k] = l.weight[k] + slip_[i] * l.slide[k];
         for (int d = 0; d < 3; ++d) u[d] -= ds * t[d] / tl;
@@ -76,7 +73,6 @@ void StitchToShellConnection::add_forces(const double* x, const double*, const d
       }
     }
     const double fk[3] = {-k_[i] * u[0], -k_[i] * u[1], -k_[i] * u[2]};
-    force_[i] = std::sqrt(fk[0] * fk[0] + fk[1] * fk[1] + fk[2] * fk[2]);
     for (int d = 0; d < 3; ++d) f[a + d] += fk[d];
     for (int k = 0; k < 4; ++k) {
       const auto h = 3 * static_cast<std::size_t>(l.host[k]);
@@ -114,8 +110,6 @@ void StitchToShellConnection::restrict_to_rank(const std::uint8_t* owned, const 
 void StitchToShellConnection::save_state(fem::CheckpointWriter& w) const {
   w.write_int("n_links", static_cast<std::int64_t>(links_.size()));
   fem::save_array(w, "slip", slip_);
-  fem::save_array(w, "slip_length", slip_len_);
-  fem::save_array(w, "force", force_);
   w.write_double("dissipated", dissipated_);
   w.write_int("n_sliding", n_sliding_);
 }
@@ -123,8 +117,6 @@ void StitchToShellConnection::save_state(fem::CheckpointWriter& w) const {
 void StitchToShellConnection::load_state(fem::CheckpointReader& r) {
   r.check_int("n_links", static_cast<std::int64_t>(links_.size()));
   fem::load_array(r, "slip", slip_);
-  fem::load_array(r, "slip_length", slip_len_);
-  fem::load_array(r, "force", force_);
   dissipated_ = r.read_double("dissipated");
   n_sliding_ = r.read_int("n_sliding");
 }

@@ -49,17 +49,13 @@ class StitchToShellConnection final : public fem::ContactAlgorithm {
   /// Slip of link i along its line so far (m of the line's reference length, signed: along
   /// the direction given to the stitch positive).
   double slip(std::size_t i) const { return slip_[i]; }
-  /// Path length slid by link i so far (m).
-  double slip_length(std::size_t i) const { return slip_len_[i]; }
   double stiffness(std::size_t i) const { return k_[i]; }
-  /// Force of the spring on the stitch node after the last add_forces (N, magnitude).
-  double force_magnitude(std::size_t i) const { return force_[i]; }
 
  private:
   std::string name_;
   ShellStitchSliderSettings s_;
   std::vector<ShellStitchLink> links_;
-  std::vector<double> k_, slip_, slip_len_, force_;
+  std::vector<double> k_, slip_;
   std::vector<std::uint8_t> mine_;  // several ranks: [n] 1 where this rank computes the link
   double dissipated_ = 0;
   std::int64_t n_sliding_ = 0;
