@@ -448,11 +448,16 @@ void PenaltyContact::sort_segments(const double* x) {
         ucand_[r] = {surf_.node[e], facet_start_[e] + cand_facet_[static_cast<std::size_t>(c)]};
       }
     best_.assign(static_cast<std::size_t>(facet_start_[n_node]), BestHit{});
+    seed_last_segments();
   }
   ++stats_.n_sorts;
   stats_.n_candidates = static_cast<std::int64_t>(cand_seg_.size());
   stats_.sort_seconds +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+namespace {
+constexpr double kStick = 1e-4;
 }
 
 void PenaltyContact::add_forces(const double* x, const double* v, const double*, double dt,
@@ -530,8 +535,9 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
           const double* xp = x + 3 * static_cast<std::size_t>(ucand[c].mesh_node);
           const SegmentProjection pr = project_on_segment(fb, li, xp[0], xp[1], xp[2]);
           BestHit& B = best[fi];
+          const auto rank = static_cast<float>(pr.gap + (B.last == s ? kStick * d : 0.0));
           bool hit = (std::abs(pr.xi) <= lim) & (std::abs(pr.eta) <= lim) & (pr.gap < thick) &
-                     (pr.gap > -d) & (pr.gap > B.gap);
+                     (pr.gap > -d) & (rank > B.gap);
           // Closest feature (see closer_adjacent_face): a tow-end node lying on a thin tow's
           // top face also projects onto the tow's side face (at its top edge), up to half the
           // tow width 'deep', and its end facet faces that side: the top face is the contact,
@@ -542,7 +548,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
                                         xp[1], xp[2], thick - pr.gap, state[fi].last == s);
           }
           if (hit) {
-            B.gap = pr.gap;
+            B.gap = rank;
             B.xi = static_cast<float>(pr.xi), B.eta = static_cast<float>(pr.eta);
             for (int k = 0; k < 3; ++k) B.n[k] = static_cast<float>(fb.n[k][l]);
             B.seg = s;
@@ -553,7 +559,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   }
   ContactBatch& B = batch_;
   B.n = 0;
-  std::int64_t n_active = 0;
+  std::int64_t n_active = 0, n_changes = 0;
   double max_pen = 0, dissipated = 0;
   std::int32_t max_pen_node = -1;
   auto flush = [&] {
@@ -591,12 +597,14 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
       const std::int32_t was = S.last;
       const BestHit F = best[fi];
       best[fi] = BestHit{};  // ready for the next cycle's narrow phase
+      best[fi].last = F.seg;
       S.last = F.seg;
       if (F.seg < 0) {
         if (was >= 0) S = FacetState{};  // else zero
         continue;
       }
       ++n_active;
+      n_changes += (was >= 0) & (was != F.seg);
       const auto s = static_cast<std::size_t>(F.seg);
       const std::int32_t* corner = sn + 4 * s;
       const int l = B.n++;
@@ -614,7 +622,8 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
       // tows) starts from zero force, and at a switch to another segment the elastic part of
       // the penetration carries over. The offset only ever shrinks while the contact lasts (the
       // node withdrawing takes it with it), so the law can lose energy but never create it.
-      const double pen_geo = thick - F.gap;
+      const double gap = static_cast<double>(F.gap) - (F.seg == was ? kStick * depth_[s] : 0.0);
+      const double pen_geo = thick - gap;
       double off = was < 0        ? pen_geo
                    : was != F.seg ? std::max(pen_geo - S.elastic, 0.0)
                                   : std::min(S.offset, pen_geo);
@@ -640,6 +649,8 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   flush();
   dissipation_ += dissipated;
   stats_.n_active = n_active;
+  stats_.n_contact_cycles += n_active;
+  stats_.n_segment_changes += n_changes;
   stats_.max_penetration = max_pen;
   stats_.run_max_penetration = std::max(stats_.run_max_penetration, max_pen);
   stats_.max_penetration_node = max_pen_node;
@@ -688,6 +699,11 @@ void PenaltyContact::save_state(CheckpointWriter& w) const {
   save_array(w, "stats_values", values);
 }
 
+void PenaltyContact::seed_last_segments() {
+  const std::size_t n = std::min(best_.size(), facet_state_.size());
+  for (std::size_t k = 0; k < n; ++k) best_[k].last = facet_state_[k].last;
+}
+
 void PenaltyContact::load_state(CheckpointReader& r) {
   const std::size_t n_node = surf_.n_nodes();
   load_array(r, "seg_eroded", seg_eroded_);
@@ -725,6 +741,7 @@ void PenaltyContact::load_state(CheckpointReader& r) {
     for (int c = 0; c < 3; ++c) f.tang[c] = tang[3 * k + static_cast<std::size_t>(c)];
     f.offset = offset[k], f.elastic = elastic[k], f.last = last[k];
   }
+  seed_last_segments();
   resort_ = resort;
   dissipation_ = r.read_double("dissipation");
   std::vector<double> pf;
@@ -748,6 +765,9 @@ std::string PenaltyContact::cost_details() const {
   os.precision(3);
   os << "candidates per node " << static_cast<double>(stats_.n_candidates) / n
      << ", active contacts per node " << static_cast<double>(active_contacts()) / n
+     << ", segment changes per contact-cycle "
+     << static_cast<double>(stats_.n_segment_changes) /
+            static_cast<double>(std::max<std::int64_t>(stats_.n_contact_cycles, 1))
      << "; bucket sorts " << stats_.sort_seconds << " s, displacement checks "
      << stats_.check_seconds << " s, narrow phase and forces " << stats_.narrow_seconds << " s";
   return os.str();

@@ -18,7 +18,8 @@
 //     the frames are in registers. Each cycle reads positions and the candidate lists only; no
 //     frame is stored, so nothing is fetched twice from memory.
 //  3. Per surface node and facet the contact is the segment the node projects into (with
-//     edge_tolerance) with the largest gap below `thickness` and above -depth, and that passes
+//     edge_tolerance) with the largest gap below `thickness` and above -depth (the facet's
+//     segment of the last cycle ranked 1e-4 depth higher, so ties do not flip), and that passes
 //     the closest-feature test against the other faces of its hexahedron (closer_adjacent_face:
 //     a node on a thin tow's top face is not pushed out through the tow's side). One contact per
 //     facet: a node on the edge of one tow, pinched between the next tow's side and the ply
@@ -63,6 +64,11 @@ struct PenaltyContactStats {
   double sort_seconds = 0;                 // time in bucket sorts (broad phase)
   double check_seconds = 0;                // time in the displacement checks
   double narrow_seconds = 0;  // time in the narrow phase (incl. segment frames) and forces
+  // Since the start (or the resume) of the run: contacts summed over cycles, and how many of them
+  // moved to another segment than the cycle before (a vibrating interface near facet corners
+  // changes often, and costs more per node: docs/performance.md).
+  std::int64_t n_contact_cycles = 0;
+  std::int64_t n_segment_changes = 0;
 };
 
 class PenaltyContact final : public ContactAlgorithm {
@@ -171,13 +177,18 @@ class PenaltyContact final : public ContactAlgorithm {
   /// arrays), written by the narrow phase and read, then reset, by the force pass.
   /// Local coordinates and normal in single precision: they only place and orient the force,
   /// the same values on the node and on the segment (momentum stays exact).
+  /// The gap is a ranking key: the facet's segment of the last cycle (`last`) gets a head start
+  /// of kStick x its depth, so that a node near the corner of facets with equal gaps keeps its
+  /// segment instead of changing it with each vibration (the force pass takes the start off).
   struct BestHit {
-    double gap = -std::numeric_limits<double>::max();
+    float gap = -std::numeric_limits<float>::max();
+    std::int32_t last = -1;  // the facet's segment in the last cycle (-1: none)
     float xi = 0, eta = 0;   // local coordinates on the segment
     float n[3] = {0, 0, 0};  // the segment's unit normal
     std::int32_t seg = -1;   // -1: no contact this cycle
   };
   std::vector<BestHit> best_;            // [n_facet]
+  void seed_last_segments();             // best_[k].last from facet_state_ (sort, restart)
   std::vector<SegmentFrame> frame_;      // [n_blocks * kFrameLanes] all frames, made at the sort
   std::vector<double> box_lo_, box_hi_;  // [n_seg][3] grown segment boxes at the sort
   std::vector<double> facet_;            // [n_snode][kMaxFacets][3] facet normals at the sort
