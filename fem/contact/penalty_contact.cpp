@@ -535,7 +535,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
           const double* xp = x + 3 * static_cast<std::size_t>(ucand[c].mesh_node);
           const SegmentProjection pr = project_on_segment(fb, li, xp[0], xp[1], xp[2]);
           BestHit& B = best[fi];
-          const auto rank = static_cast<float>(pr.gap + (B.last == s ? kStick * d : 0.0));
+          const double rank = pr.gap + (B.last == s ? kStick * d : 0.0);
           bool hit = (std::abs(pr.xi) <= lim) & (std::abs(pr.eta) <= lim) & (pr.gap < thick) &
                      (pr.gap > -d) & (rank > B.gap);
           // Closest feature (see closer_adjacent_face): a tow-end node lying on a thin tow's
@@ -622,7 +622,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
       // tows) starts from zero force, and at a switch to another segment the elastic part of
       // the penetration carries over. The offset only ever shrinks while the contact lasts (the
       // node withdrawing takes it with it), so the law can lose energy but never create it.
-      const double gap = static_cast<double>(F.gap) - (F.seg == was ? kStick * depth_[s] : 0.0);
+      const double gap = F.gap - (F.seg == was ? kStick * depth_[s] : 0.0);
       const double pen_geo = thick - gap;
       double off = was < 0        ? pen_geo
                    : was != F.seg ? std::max(pen_geo - S.elastic, 0.0)

@@ -173,7 +173,7 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<std::int32_t> used_seg_, used_cand_start_, ucand_node_;
   std::vector<Candidate> ucand_;
   std::vector<std::int32_t> seg_count_;  // [n_seg + 1] work array of the counting sort
-  /// Best hit of a node facet in the current cycle: one record of 32 bytes per facet (was three
+  /// Best hit of a node facet in the current cycle: one record of 40 bytes per facet (was three
   /// arrays), written by the narrow phase and read, then reset, by the force pass.
   /// Local coordinates and normal in single precision: they only place and orient the force,
   /// the same values on the node and on the segment (momentum stays exact).
@@ -181,11 +181,11 @@ class PenaltyContact final : public ContactAlgorithm {
   /// of kStick x its depth, so that a node near the corner of facets with equal gaps keeps its
   /// segment instead of changing it with each vibration (the force pass takes the start off).
   struct BestHit {
-    float gap = -std::numeric_limits<float>::max();
+    double gap = -std::numeric_limits<double>::max();
     std::int32_t last = -1;  // the facet's segment in the last cycle (-1: none)
+    std::int32_t seg = -1;   // -1: no contact this cycle
     float xi = 0, eta = 0;   // local coordinates on the segment
     float n[3] = {0, 0, 0};  // the segment's unit normal
-    std::int32_t seg = -1;   // -1: no contact this cycle
   };
   std::vector<BestHit> best_;            // [n_facet]
   void seed_last_segments();             // best_[k].last from facet_state_ (sort, restart)
