@@ -545,7 +545,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
           if (hit && adj[0] >= 0) {
             const auto e = static_cast<std::size_t>(unode[c]);
             hit = !closer_adjacent_face(x, adj, &facet_[3 * kMaxFacets * e], n_facets[e], xp[0],
-                                        xp[1], xp[2], thick - pr.gap, state[fi].last == s);
+                                        xp[1], xp[2], thick - pr.gap, B.last == s);
           }
           if (hit) {
             B.gap = rank;

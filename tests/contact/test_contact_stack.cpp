@@ -160,7 +160,7 @@ TEST(ContactStack, PenaltyDoesNotLowerTheStableStepOfTwelvePlies) {
 // at the same gap up to round-off and the plies' vibration. The node keeps the segment it had
 // unless another is nearer by more than 1e-4 of the segment's depth: pressed (no sliding, so no
 // node crosses a facet edge) the contacts keep their segments; before this rule a quarter of
-// them changed segment every cycle in such a stack (docs/performance.md, "Contact").
+// them changed segment every cycle in such a stack (fem/contact/README.md, Method).
 TEST(ContactStack, PliesMeshedAlikeKeepTheirSegmentsWhilePressed) {
   Stack s;
   build_stack(s, 4, 8, 8, 8e-3, 8e-3, true, 0.1, true);
