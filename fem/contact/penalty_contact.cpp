@@ -353,8 +353,12 @@ void PenaltyContact::sort_segments(const double* x) {
   }
 
   force_node_.resize(n_node);
-  for (std::size_t e = 0; e < n_node; ++e)
+  facet_node_.resize(static_cast<std::size_t>(facet_start_[n_node]));
+  for (std::size_t e = 0; e < n_node; ++e) {
     force_node_[e] = {surf_.node[e], surf_.node_group[e], facet_start_[e], n_facets_[e]};
+    for (std::int32_t k = facet_start_[e]; k < facet_start_[e + 1]; ++k)
+      facet_node_[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(e);
+  }
 
   // Friction state and last contact segment carried over facet by facet.
   facet_state_.assign(static_cast<std::size_t>(facet_start_[n_node]), FacetState{});
@@ -509,6 +513,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   FacetState* state = facet_state_.data();
   BestHit* best = best_.data();  // all reset (seg -1) by the force pass of the last cycle
   {
+    std::uint64_t* live = live_.data();
     const std::size_t n_used = used_seg_.size();
     const std::int32_t* used = used_seg_.data();
     const std::int32_t* ustart = used_cand_start_.data();
@@ -552,6 +557,7 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
             B.xi = static_cast<float>(pr.xi), B.eta = static_cast<float>(pr.eta);
             for (int k = 0; k < 3; ++k) B.n[k] = static_cast<float>(fb.n[k][l]);
             B.seg = s;
+            live[fi >> 6] |= std::uint64_t{1} << (fi & 63);
           }
         }
       }
@@ -582,16 +588,18 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
     }
     B.n = 0;
   };
+  // Only the facets in play are visited: those hit in this cycle's narrow phase and those in
+  // contact in the last one (to end it). They are taken in increasing facet order, which is
+  // surface-node order, so the forces are summed in the same order as a pass over every node.
   const ForceNode* fnode = force_node_.data();
-  for (std::size_t e = 0; e < n_node; ++e) {
-    const ForceNode R = fnode[e];
-    const int nf = R.n_facets;
-    const auto f0 = static_cast<std::size_t>(R.facet_start);
-    const auto i = static_cast<std::size_t>(R.mesh_node);
-    const double m_s = m_node[i];
-    const double vsx = v[3 * i], vsy = v[3 * i + 1], vsz = v[3 * i + 2];
-    const std::size_t row = static_cast<std::size_t>(R.group) * ng;
-    for (std::size_t fi = f0; fi < f0 + static_cast<std::size_t>(nf); ++fi) {
+  const std::int32_t* facet_node = facet_node_.data();
+  std::uint64_t* live = live_.data();
+  for (std::size_t w = 0; w < live_.size(); ++w) {
+    for (std::uint64_t bits = live[w]; bits != 0; bits &= bits - 1) {
+      const auto bit = static_cast<unsigned>(__builtin_ctzll(bits));
+      const std::size_t fi = 64 * w + bit;
+      const ForceNode R = fnode[facet_node[fi]];
+      const auto i = static_cast<std::size_t>(R.mesh_node);
       FacetState& S = state[fi];
       double* ft = S.tang;
       const std::int32_t was = S.last;
@@ -601,8 +609,12 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
       S.last = F.seg;
       if (F.seg < 0) {
         if (was >= 0) S = FacetState{};  // else zero
+        live[w] &= ~(std::uint64_t{1} << bit);
         continue;
       }
+      const double m_s = m_node[i];
+      const double vsx = v[3 * i], vsy = v[3 * i + 1], vsz = v[3 * i + 2];
+      const std::size_t row = static_cast<std::size_t>(R.group) * ng;
       ++n_active;
       n_changes += (was >= 0) & (was != F.seg);
       const auto s = static_cast<std::size_t>(F.seg);
@@ -701,7 +713,11 @@ void PenaltyContact::save_state(CheckpointWriter& w) const {
 
 void PenaltyContact::seed_last_segments() {
   const std::size_t n = std::min(best_.size(), facet_state_.size());
-  for (std::size_t k = 0; k < n; ++k) best_[k].last = facet_state_[k].last;
+  live_.assign((best_.size() + 63) / 64, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    best_[k].last = facet_state_[k].last;
+    if (facet_state_[k].last >= 0) live_[k >> 6] |= std::uint64_t{1} << (k & 63);
+  }
 }
 
 void PenaltyContact::load_state(CheckpointReader& r) {

@@ -155,6 +155,11 @@ class PenaltyContact final : public ContactAlgorithm {
     std::int32_t mesh_node, group, facet_start, n_facets;
   };
   std::vector<ForceNode> force_node_;        // [n_snode]
+  std::vector<std::int32_t> facet_node_;     // [n_facet] its surface node
+  /// [n_facet bits] facets in play: hit in this cycle's narrow phase, or in contact in the last
+  /// cycle. The force pass visits only these (on a fabric ~0.1 contacts per node: a pass over
+  /// every surface node's records, on every rank over the whole model's, was most of its cost).
+  std::vector<std::uint64_t> live_;
   std::vector<FacetState> facet_state_;      // [n_facet]
   std::vector<FacetState> facet_state_old_;  // before the last sort (carried over)
   std::vector<std::int32_t> facet_start_;    // [n_snode + 1] first facet of each surface node
