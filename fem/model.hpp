@@ -83,9 +83,13 @@ struct TimeControl {
 // Runs on several MPI ranks (docs/parallel.md).
 struct ParallelControl {
   // How far from its own surface nodes a rank keeps the remote contact segments (the contact
-  // halo, fixed at the start): surfaces that slide further than this relative to each other
-  // across a partition boundary during the run are not seen, m.
+  // halo): surfaces that slide further than this relative to each other across a partition
+  // boundary between two builds of the halo are not seen (the run stops, naming it), m.
   double contact_halo = 0.01;
+  // The halo is built again at the nodes' current positions once they may have slid this share
+  // of it relative to each other (a pass over the owned nodes and a max over the ranks decide,
+  // when a running bound on the nodes' travel says it could be so); 0: fixed at the start.
+  double contact_halo_refresh = 0.25;
 };
 
 struct Model {

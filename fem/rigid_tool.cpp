@@ -278,12 +278,19 @@ double RigidSurface::reach_distance(const V3& p, double offset) const {
 }
 
 void tool_contact_forces(RigidTool& tool, const double* x, const double* v, const double* mass,
-                         double dt, double* fc) {
+                         double dt, double* fc, double node_travel) {
   const std::size_t n = tool.contact_nodes.size();
   if (tool.tangential.size() != 3 * n) tool.tangential.assign(3 * n, 0.0);
   const double inv_dt2 = 1.0 / (dt * dt);
   ToolProximity& near = tool.proximity;
-  if (near.valid) {  // can a node outside the near list have closed the margin since?
+  const double tool_moved = near.valid ? norm(tool.displacement - near.tool_ref) : 0.0;
+  // The displacement check is needed only when the last one's largest displacement plus the
+  // bound on the nodes' travel since could reach the margin (it would pass otherwise).
+  const bool check = near.valid && (node_travel < 0 || near.checked_travel < 0 ||
+                                    near.checked_d + (node_travel - near.checked_travel) +
+                                            tool_moved >=
+                                        near.margin);
+  if (check) {  // can a node outside the near list have closed the margin since?
     double d2 = 0;
     const double* xr = near.x_ref.data();
     for (std::size_t s = 0; s < n; ++s) {
@@ -291,7 +298,10 @@ void tool_contact_forces(RigidTool& tool, const double* x, const double* v, cons
       const double dx = p[0] - xr[3 * s], dy = p[1] - xr[3 * s + 1], dz = p[2] - xr[3 * s + 2];
       d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
     }
-    near.valid = std::sqrt(d2) + norm(tool.displacement - near.tool_ref) < near.margin;
+    near.valid = std::sqrt(d2) + tool_moved < near.margin;
+    near.checked_d = std::sqrt(d2);
+    near.checked_travel = node_travel;
+    ++near.n_checks;
   }
   V3 ftool{};
   std::int64_t active = 0;
@@ -313,6 +323,8 @@ void tool_contact_forces(RigidTool& tool, const double* x, const double* v, cons
         near.near.push_back(static_cast<std::int32_t>(s));
     }
     near.tool_ref = tool.displacement;
+    near.checked_d = 0;
+    near.checked_travel = node_travel;
     near.valid = true;
     ++near.n_rebuilds;
   }

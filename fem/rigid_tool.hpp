@@ -62,7 +62,13 @@ struct ToolProximity {
   std::vector<std::int32_t> near;  // indices into RigidTool::contact_nodes
   std::vector<double> x_ref;       // [3*n_contact_nodes] positions at the last rebuild
   V3 tool_ref;                     // tool displacement at the last rebuild
+  // The last displacement check: the caller's node travel bound then (< 0: none since the start
+  // or the resume) and the largest node displacement from x_ref it found. While that plus the
+  // travel since and the tool's own displacement stay below the margin, the check is skipped.
+  double checked_travel = -1;
+  double checked_d = 0;
   std::int64_t n_rebuilds = 0;
+  std::int64_t n_checks = 0;  // displacement checks done (a pass over the contact nodes)
   bool valid = false;
 };
 
@@ -118,8 +124,11 @@ V3 tool_prescribed_velocity(const RigidTool& tool, double t);
 
 /// Contact forces of one tool at positions x, velocities v (last half step) and step dt;
 /// adds the forces on the nodes into f_contact [3*n_nodes] and updates the tool's state.
+/// node_travel: a running bound on how far any contact node has moved since the start (the
+/// solver's sum over cycles of its largest node displacement), or < 0 when the caller has none;
+/// with it the proximity cull's displacement check is skipped in the cycles where it cannot fail.
 void tool_contact_forces(RigidTool& tool, const double* x, const double* v, const double* mass,
-                         double dt, double* f_contact);
+                         double dt, double* f_contact, double node_travel = -1);
 
 /// Takes the nodes flagged in `gone` ([n_nodes], 1: gone) out of the tool's contact nodes (nodes
 /// left with no element by erosion); their friction state goes with them, the near list is

@@ -36,6 +36,7 @@ double seconds_since(Clock::time_point t0) {
 // Sums over the DOFs of F.v^{n-1/2}, F.v^{n+1/2} per force kind and m v^{n-1/2} v^{n+1/2}.
 struct NodeUpdateSums {
   double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
+  double v_max = 0;  // largest |v| component of v^{n+1/2} (bounds the cycle's node motion)
 };
 
 // v^{n+1/2} of every DOF as if free, branch-free so that it vectorises; with kMoveX the positions
@@ -48,7 +49,9 @@ NodeUpdateSums free_node_update(std::size_t nd, double alpha, double dt_mid, dou
                                 const double* fe, const double* fcon, double* vel, double* fdamp,
                                 double* x) {
   double ext_old = 0, ext_new = 0, damp_old = 0, damp_new = 0, con_old = 0, con_new = 0, ke = 0;
-#pragma omp simd reduction(+ : ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke)
+  double v_max = 0;
+#pragma omp simd reduction(+ : ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke) \
+    reduction(max : v_max)
   for (std::size_t d = 0; d < nd; ++d) {
     const double vo = vel[d], m = mm[d];
     double f = fi[d];
@@ -63,8 +66,9 @@ NodeUpdateSums free_node_update(std::size_t nd, double alpha, double dt_mid, dou
     if constexpr (kDamp) fdamp[d] = fd, damp_old += fd * vo, damp_new += fd * vn;
     if constexpr (kContact) con_old += fcon[d] * vo, con_new += fcon[d] * vn;
     ke += m * vo * vn;
+    v_max = std::max(v_max, std::abs(vn));
   }
-  return {ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke};
+  return {ext_old, ext_new, damp_old, damp_new, con_old, con_new, ke, v_max};
 }
 
 using NodeUpdate = NodeUpdateSums (*)(std::size_t, double, double, double, const double*,
@@ -90,6 +94,7 @@ NodeUpdateSums owned_node_update(NodeUpdate f,
                                fe + d, fcon + d, vel + d, fdamp + d, x ? x + d : nullptr);
     s.ext_old += r.ext_old, s.ext_new += r.ext_new, s.damp_old += r.damp_old;
     s.damp_new += r.damp_new, s.con_old += r.con_old, s.con_new += r.con_new, s.ke += r.ke;
+    s.v_max = std::max(s.v_max, r.v_max);
   }
   return s;
 }
@@ -253,6 +258,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
       dt_ = std::min(dt_, c->stable_step_limit());
     }
     contact_seconds_.assign(model_.contacts.size(), 0.0);
+    tool_seconds_.assign(model_.tools.size(), 0.0);
   }
   if (domain_) {
     // What each rank's contacts read of the others, then the exchange that keeps it current.
@@ -269,6 +275,7 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
     domain_->finalise();
     for (auto& c : model_.contacts)
       c->restrict_to_rank(domain_->owned_mask().data(), domain_->readable_mask().data());
+    halo_x_.assign(X0.data(), X0.data() + 3 * n);
   }
   dt_initial_ = dt_;
   vpres_.resize(model_.velocities.size());
@@ -445,6 +452,7 @@ void ExplicitSolver::build_blocks() {
     }
   }
   group_step_.resize(groups_.size());
+  group_seconds_.assign(groups_.size(), 0.0);
 }
 
 void ExplicitSolver::build_motions() {
@@ -744,6 +752,51 @@ void ExplicitSolver::throw_blow_up_of(int from, const std::string& what) const {
   throw NumericalError(msg);
 }
 
+// Several ranks: a rank reads the remote contact segments within the halo of its own surface
+// nodes. As the surfaces slide, the halo is built again at the nodes' current positions before
+// any could have slid `contact_halo_refresh` of it relative to another surface (each node at most
+// half that from its position at the last build): exact, the contacts found are those of a halo
+// built at the start wide enough for the whole run. The decision is the same on every rank (a
+// bound summed over the ranks, then a max over the ranks).
+void ExplicitSolver::refresh_contact_halo(double* x, double* v) {
+  const double share = model_.parallel.contact_halo_refresh;
+  if (share <= 0) return;
+  const double reach = 0.5 * share * model_.parallel.contact_halo;
+  if (!halo_due_ && halo_checked_d_ + (halo_travel_ - halo_travel_checked_) < reach) return;
+  double d = 0;
+  if (!halo_due_) {
+    double d2 = 0;
+    for (const auto& [b, e] : domain_->owned_runs())
+      for (std::size_t i = b; i < e; ++i) {
+        const double dx = x[3 * i] - halo_x_[3 * i], dy = x[3 * i + 1] - halo_x_[3 * i + 1],
+                     dz = x[3 * i + 2] - halo_x_[3 * i + 2];
+        d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
+      }
+    d = std::sqrt(d2);
+    MPI_Allreduce(MPI_IN_PLACE, &d, 1, MPI_DOUBLE, MPI_MAX, domain_->comm());
+    if (d < reach) {
+      halo_checked_d_ = d, halo_travel_checked_ = halo_travel_;
+      return;
+    }
+  }
+  // Every node's position from its owner (a rank's copies of the nodes it does not read are
+  // stale), the halo at those positions, the ghosts that go with it.
+  domain_->gather_to_all(x);
+  std::vector<std::int32_t> extra, part;
+  for (auto& c : model_.contacts) {
+    part.clear();
+    c->nodes_to_read(domain_->owned_mask().data(), x, model_.parallel.contact_halo, part);
+    extra.insert(extra.end(), part.begin(), part.end());
+  }
+  domain_->rebuild_ghosts(extra, x, v);
+  for (auto& c : model_.contacts)
+    c->restrict_to_rank(domain_->owned_mask().data(), domain_->readable_mask().data());
+  halo_x_.assign(x, x + 3 * model_.mesh.n_nodes());
+  halo_travel_ = halo_checked_d_ = halo_travel_checked_ = 0;
+  if (!halo_due_) ++halo_builds_;  // the build at a resume is not counted: as uninterrupted
+  halo_due_ = false;
+}
+
 // One cycle of central differences: the phases below in order, each reading what the ones before
 // left in `c`. The vectors' views are held over them and released before the callback, which may
 // read the vectors itself.
@@ -762,6 +815,11 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
     auto Rr = reaction.view();
     const CycleArrays a{X.data(),  Vv.data(), X0.data(), M.data(), Fi.data(),
                         Fe.data(), Fc.data(), Fd.data(), Rr.data()};
+    if (domain_ && !model_.contacts.empty()) {
+      const auto th = Clock::now();
+      refresh_contact_halo(a.x, a.v);
+      timers_.exchange += seconds_since(th);
+    }
     auto t0 = Clock::now();
     internal_forces(a, c);
     erode_and_choose_step(a, c);
@@ -811,8 +869,10 @@ void ExplicitSolver::internal_forces(const CycleArrays& a, Cycle& c) {
   // count or the step); this rank skips the rest of the cycle's work until then.
   for (std::size_t k = 0; k < groups_.size() && c.blow_up.empty(); ++k) {
     group_step_[k] = StableStep{};
+    const auto t0 = Clock::now();
     try {
       groups_[k]->internal_forces(cs, a.fi, c.inc, group_step_[k]);
+      group_seconds_[k] += seconds_since(t0);
     } catch (const NumericalError& e) {
       if (!domain_) throw;
       c.blow_up = e.what();
@@ -856,7 +916,11 @@ void ExplicitSolver::contact_forces(const CycleArrays& a, Cycle& c) {
   if (!c.blow_up.empty()) return;  // several ranks: stopping at the step's reduction
   const double dt_c = dt_prev_ > 0 ? dt_prev_ : c.dt_new;
   try {
-    for (auto& tool : model_.tools) tool_contact_forces(tool, a.x, a.v, a.m, dt_c, a.fc);
+    for (std::size_t q = 0; q < model_.tools.size(); ++q) {
+      const auto t0 = Clock::now();
+      tool_contact_forces(model_.tools[q], a.x, a.v, a.m, dt_c, a.fc, node_travel_);
+      tool_seconds_[q] += seconds_since(t0);
+    }
     for (std::size_t q = 0; q < model_.contacts.size(); ++q) {
       const auto t0 = Clock::now();
       auto& k = model_.contacts[q];
@@ -1016,6 +1080,12 @@ void ExplicitSolver::update_velocities(const CycleArrays& a, Cycle& c) {
     inv_mass_[d] = 0;
   }
   freeing_.clear();
+  // How far any node of this rank can have moved in this cycle (x += dt v; the rounding of a
+  // component's sum at most doubles its increment): the rigid tools skip their displacement
+  // check while this bound cannot have taken a node past their margin (same results).
+  double v_max = s.v_max;
+  for (const std::size_t d : constrained_) v_max = std::max(v_max, std::abs(vel[d]));
+  node_travel_ += 3.5 * dt_new * v_max;
   // An eroded element's nodes may be owned elsewhere: their v^{n+1/2} first.
   if (domain_ && eroded_any_) domain_->refresh_ghosts(vel);
   for (const auto& ef : eroded_forces_)  // see ErodedForce
@@ -1053,11 +1123,15 @@ void ExplicitSolver::sum_over_ranks(Cycle& c) {
   // The loop's requests (raise_requests), one count per flag: 0 where no rank raised it.
   const std::size_t at_requests = r.size();
   for (unsigned b = 0; (kRequestMask >> b) != 0; ++b) r.push_back((requests_ >> b) & 1u);
+  // This cycle's bound on the rank's node travel: summed, a bound for every node (the halo).
+  r.push_back(node_travel_ - node_travel_sent_);
+  node_travel_sent_ = node_travel_;
   MPI_Allreduce(MPI_IN_PLACE, r.data(), static_cast<int>(r.size()), MPI_DOUBLE, MPI_SUM,
                 domain_->comm());
   requests_all_ranks_ = 0;
   for (unsigned b = 0; (kRequestMask >> b) != 0; ++b)
     if (r[at_requests + b] > 0) requests_all_ranks_ |= 1u << b;
+  halo_travel_ += r.back();
   c.ext_old = r[0], c.ext_new = r[1], c.damp_old = r[2], c.damp_new = r[3], c.con_old = r[4],
   c.con_new = r[5], c.ke = r[6];
   energy_.internal = booked0[0] + r[11] + r[7];
@@ -1203,6 +1277,7 @@ void ExplicitSolver::save_state(CheckpointWriter& w) const {
   w.write_double("dt_prev", dt_prev_);
   w.write_double("dt_initial", dt_initial_);
   w.write_int("cycle", cycle_);
+  w.write_int("contact_halo_builds", halo_builds_);
   w.write_double("step_dt", step_.dt);
   w.write_int("step_element", step_.element);
   w.write_int("step_kind", static_cast<std::int64_t>(step_.kind));
@@ -1278,6 +1353,8 @@ void ExplicitSolver::load_state(CheckpointReader& r) {
   if (cycle_ != 0 || t_ != 0)
     throw std::logic_error("ExplicitSolver::load_state: the solver has already stepped");
   const std::size_t n = model_.mesh.n_nodes();
+  // The contact halo was built at the start positions: built again at the saved ones.
+  halo_due_ = domain_ && !model_.contacts.empty() && model_.parallel.contact_halo_refresh > 0;
   CheckpointScope<CheckpointReader> solver(r, "solver");
   r.check_int("n_nodes", static_cast<std::int64_t>(n));
   {
@@ -1297,6 +1374,7 @@ void ExplicitSolver::load_state(CheckpointReader& r) {
   dt_ = r.read_double("dt");
   dt_prev_ = r.read_double("dt_prev");
   cycle_ = r.read_int("cycle");
+  halo_builds_ = r.has("contact_halo_builds") ? r.read_int("contact_halo_builds") : 0;
   step_.dt = r.read_double("step_dt");
   step_.element = r.read_int("step_element");
   step_.kind = static_cast<ElementKind>(r.read_int("step_kind"));

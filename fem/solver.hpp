@@ -108,6 +108,18 @@ class ExplicitSolver {
   double contact_seconds(std::size_t k) const {
     return k < contact_seconds_.size() ? contact_seconds_[k] : 0.0;
   }
+  /// Seconds spent in rigid tool k (model().tools[k]) so far, part of timers().contact.
+  double tool_seconds(std::size_t k) const {
+    return k < tool_seconds_.size() ? tool_seconds_[k] : 0.0;
+  }
+  /// Seconds spent in element group k's internal forces (groups()[k]) so far, part of
+  /// timers().internal_force (the rest: erosion checks and the choice of the step).
+  double group_seconds(std::size_t k) const {
+    return k < group_seconds_.size() ? group_seconds_[k] : 0.0;
+  }
+  /// Several ranks: how many times the contact halo was built again as the nodes moved
+  /// (parallel.contact_halo_refresh; since the start or the resume).
+  std::int64_t contact_halo_builds() const { return halo_builds_; }
   /// The split over MPI ranks (fem/parallel/domain.hpp); null on one rank.
   const Domain* domain() const { return domain_.get(); }
   /// Several ranks: flags (bits 0-3) the caller's loop raises on this rank (a stop, a
@@ -256,6 +268,8 @@ class ExplicitSolver {
   double friction_all_ranks_ = 0;  // several ranks: friction dissipated, summed this cycle
   unsigned requests_ = 0, requests_all_ranks_ = 0;  // several ranks: see raise_requests
   std::vector<double> contact_seconds_;             // per contact, see contact_seconds
+  std::vector<double> tool_seconds_;                // per rigid tool, see tool_seconds
+  std::vector<double> group_seconds_;               // per element group, see group_seconds
   std::vector<std::vector<ContactResultant>> contact_resultants_;  // several ranks: summed
   std::vector<double> contact_max_penetration_;
   std::array<double, 4> motion_work_all_ranks_{};  // several ranks: the rigs' wall works, summed
@@ -273,6 +287,18 @@ class ExplicitSolver {
   std::vector<ErodedForce> eroded_forces_;
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
+  // Sum over the cycles of a bound on this rank's largest node displacement in each (m): the
+  // rigid tools' proximity cull compares its growth with their margin (not checkpointed: after a
+  // resume the tools check once and start from there).
+  double node_travel_ = 0;
+  // Several ranks, the contact halo built again as the nodes move (refresh_contact_halo): the
+  // positions at the last build, a bound on the largest node displacement since (summed over
+  // the ranks each cycle, the same on all), the last exact check of it, and the builds so far.
+  std::vector<double> halo_x_;
+  double halo_travel_ = 0, halo_checked_d_ = 0, halo_travel_checked_ = 0, node_travel_sent_ = 0;
+  bool halo_due_ = false;  // build at the next cycle (after a resume)
+  std::int64_t halo_builds_ = 0;
+  void refresh_contact_halo(double* x, double* v);
   std::vector<V3> vpres_;         // prescribed velocities at t^{n+1/2}, one per set
   std::vector<double> motion_v_;  // per constrained DOF: velocity from its boundary motion
   bool has_motion_forces_ = false;

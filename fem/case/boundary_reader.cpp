@@ -100,8 +100,11 @@ void read_loads(CaseReadContext& ctx) {
     model.mass_damping = d->number("mass_proportional", 0.0, Range::non_negative());
     model.mass_damping_end_time = d->number("end_time", 0.0, Range::non_negative());
   }
-  if (auto par = ctx.root.table("parallel"))
+  if (auto par = ctx.root.table("parallel")) {
     model.parallel.contact_halo = par->number("contact_halo", 0.01, Range::positive());
+    model.parallel.contact_halo_refresh =
+        par->number("contact_halo_refresh", 0.25, Range::closed(0.0, 0.5));
+  }
   if (auto init = ctx.root.table("initial"))
     for (const auto& t : init->tables("velocity"))
       model.initial_velocities.push_back(

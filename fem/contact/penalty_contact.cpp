@@ -418,9 +418,10 @@ void PenaltyContact::sort_segments(const double* x) {
             ") m reached the edge of the segments this rank reads (those within [parallel] "
             "contact_halo = " +
             std::to_string(halo_) +
-            " m of its surface nodes at the start): the surfaces slid about that far relative "
-            "to each other across the partition, or the halo is small for this mesh, and "
-            "contacts beyond it would be missed; raise parallel.contact_halo or run on fewer "
+            " m of its surface nodes when the halo was last built): the surfaces slid about "
+            "that far relative to each other across the partition since, or the halo is small "
+            "for this mesh, and contacts beyond it would be missed; raise "
+            "parallel.contact_halo, lower parallel.contact_halo_refresh (not 0) or run on fewer "
             "ranks");
       cand_seg_.push_back(static_cast<std::int32_t>(s));
       cand_facet_.push_back(static_cast<std::uint8_t>(facet));

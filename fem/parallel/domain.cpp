@@ -192,6 +192,7 @@ Domain::Domain(MPI_Comm comm, std::size_t n_nodes, const double* x0,
 Domain::~Domain() {
   if (ghost_sf_) PetscSFDestroy(&ghost_sf_);
   if (gather_sf_) PetscSFDestroy(&gather_sf_);
+  if (all_sf_) PetscSFDestroy(&all_sf_);
   if (exchange_sf_) PetscSFDestroy(&exchange_sf_);
   if (node3_ != MPI_DATATYPE_NULL) MPI_Type_free(&node3_);
   if (node6_ != MPI_DATATYPE_NULL) MPI_Type_free(&node6_);
@@ -203,19 +204,46 @@ std::pair<std::size_t, std::size_t> Domain::range(std::size_t g, int r) const {
 
 void Domain::add_readable(std::span<const std::int32_t> nodes) {
   if (ghost_sf_) throw std::logic_error("Domain::add_readable after finalise");
+  if (base_readable_.empty()) base_readable_ = readable_;
   for (auto i : nodes) readable_[static_cast<std::size_t>(i)] = 1;
 }
 
 void Domain::finalise() {
-  ghosts_.clear();
-  for (std::size_t i = 0; i < n_nodes_; ++i)
-    if (readable_[i] && !owned_[i]) ghosts_.push_back(static_cast<std::int32_t>(i));
-  ghost_sf_ = node_sf(comm_, n_nodes_, ghosts_, owner_);
+  if (base_readable_.empty()) base_readable_ = readable_;
   std::vector<std::int32_t> remote;
   if (root())
     for (std::size_t i = 0; i < n_nodes_; ++i)
       if (!owned_[i]) remote.push_back(static_cast<std::int32_t>(i));
   gather_sf_ = node_sf(comm_, n_nodes_, remote, owner_);
+  build_exchange();
+}
+
+void Domain::rebuild_ghosts(std::span<const std::int32_t> extra, double* x, double* v) {
+  readable_ = base_readable_;
+  for (auto i : extra) readable_[static_cast<std::size_t>(i)] = 1;
+  if (ghost_sf_) PetscSFDestroy(&ghost_sf_);
+  if (exchange_sf_) PetscSFDestroy(&exchange_sf_);
+  shared_.clear();
+  build_exchange();
+  refresh_ghosts(x, v);
+}
+
+void Domain::gather_to_all(double* a) {
+  if (!all_sf_) {
+    std::vector<std::int32_t> remote;
+    for (std::size_t i = 0; i < n_nodes_; ++i)
+      if (!owned_[i]) remote.push_back(static_cast<std::int32_t>(i));
+    all_sf_ = node_sf(comm_, n_nodes_, remote, owner_);
+  }
+  NCF_PETSC(PetscSFBcastBegin(all_sf_, node3_, a, a, MPI_REPLACE));
+  NCF_PETSC(PetscSFBcastEnd(all_sf_, node3_, a, a, MPI_REPLACE));
+}
+
+void Domain::build_exchange() {
+  ghosts_.clear();
+  for (std::size_t i = 0; i < n_nodes_; ++i)
+    if (readable_[i] && !owned_[i]) ghosts_.push_back(static_cast<std::int32_t>(i));
+  ghost_sf_ = node_sf(comm_, n_nodes_, ghosts_, owner_);
   // What the owners send back per cycle: x and v of the ghosts that others read of mine, plus
   // the forces I add into others' nodes (two arrays).
   PetscInt n_roots = 0, n_leaves = 0;

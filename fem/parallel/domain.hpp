@@ -60,6 +60,14 @@ class Domain {
   void add_readable(std::span<const std::int32_t> nodes);
   /// Builds the ghost exchange (collective). No add_readable after it.
   void finalise();
+  /// Rebuilds the ghost exchange after finalise() (collective): this rank reads its owned nodes,
+  /// its elements' corners and `extra` (what its contacts read now: a contact halo built again
+  /// at the nodes' current positions), then every ghost is refreshed from its owner (x and v).
+  void rebuild_ghosts(std::span<const std::int32_t> extra, double* x, double* v);
+  /// Copies every node's entries from its owner into every rank's array [3*n_nodes]
+  /// (collective; the whole field on each rank, e.g. the current positions before a halo is
+  /// built again; an SF made at the first call).
+  void gather_to_all(double* a);
   std::size_t n_ghosts() const { return ghosts_.size(); }
 
   /// Adds the ghost entries of the nodal force arrays [3*n_nodes] f_int and f_contact (null: no
@@ -89,11 +97,14 @@ class Domain {
   std::vector<std::vector<std::pair<std::size_t, std::size_t>>> all_ranges_;  // [group][rank]
   std::vector<int> owner_;
   std::vector<std::uint8_t> owned_, readable_;
+  std::vector<std::uint8_t> base_readable_;  // readable_ before add_readable (owned, elements)
   std::vector<std::pair<std::size_t, std::size_t>> runs_;
   std::vector<std::int32_t> ghosts_;
   std::vector<std::int32_t> shared_;  // owned nodes that other ranks read (ascending)
   PetscSF ghost_sf_ = nullptr;   // leaves: this rank's ghosts; roots: the owners' entries
   PetscSF gather_sf_ = nullptr;  // leaves (root only): nodes the root does not own
+  PetscSF all_sf_ = nullptr;     // leaves: every node this rank does not own (gather_to_all)
+  void build_exchange();         // ghosts_, ghost_sf_, shared_, exchange_sf_ from readable_
   // The per-cycle exchange on packed buffers: leaf k is ghosts_[k], root k is shared_[k].
   PetscSF exchange_sf_ = nullptr;
   mutable std::vector<double> leaf_buf_, root_buf_;  // [6 * ghosts], [6 * shared]

@@ -214,6 +214,48 @@ TEST(MpiRuns, BlowUpOnOneRankStopsEveryRankWithItsReport) {
   }
 }
 
+// A block pressed by 5 N and dragged 40 mm over a plate cut in two by the partition
+// (tests/cases/mpi/sliding_block.toml): with the contact halo fixed at the start it slides past
+// the segments its rank reads and the run stops (exit 3); built again as the nodes move (the
+// default parallel.contact_halo_refresh) the run ends on 2 ranks as on 1: every history column
+// within 1e-6 of its scale (round-off of the sums' order), and the drag is mu P = 0.2 x 5 N.
+TEST(MpiRuns, ContactHaloIsBuiltAgainAsTheSurfacesSlide) {
+  if (!launcher_works()) GTEST_SKIP() << "the MPI launcher does not start here";
+  const fs::path file = kSource / "tests/cases/mpi/sliding_block.toml";
+  const fs::path fixed = fresh_dir("mpi_halo_fixed"), moving = fresh_dir("mpi_halo_moving"),
+                 one = fresh_dir("mpi_halo_one");
+  const Result rf = run_cli({"run", file.string(), "-o", fixed.string(), "--np", "2", "--set",
+                             "parallel.contact_halo_refresh=0"});
+  EXPECT_EQ(rf.code, 3) << rf.output;
+  EXPECT_NE(rf.output.find("reached the edge of the segments this rank reads"), std::string::npos)
+      << rf.output;
+  const Result r2 = run_cli({"run", file.string(), "-o", moving.string(), "--np", "2"});
+  ASSERT_EQ(r2.code, 0) << r2.output;
+  const auto s = nlohmann::json::parse(slurp(moving / "summary.json"));
+  EXPECT_EQ(s["status"], "completed");
+  // 40 mm of travel, a build every 1.25 mm of it (half of 0.25 x 10 mm: each surface's share).
+  EXPECT_GE(s["contact_halo_builds"].get<int>(), 25);
+  EXPECT_LE(s["contact_halo_builds"].get<int>(), 40);
+  const Result r1 = run_cli({"run", file.string(), "-o", one.string()});
+  ASSERT_EQ(r1.code, 0) << r1.output;
+  const History h1 = read_history(one / "history.csv"), h2 = read_history(moving / "history.csv");
+  ASSERT_EQ(h1.rows.size(), h2.rows.size());
+  ASSERT_EQ(h1.columns, h2.columns);
+  for (std::size_t c = 0; c < h1.columns.size(); ++c) {
+    if (h1.columns[c] == "energy_balance_error") continue;  // a ratio of round-off
+    double scale = 0, diff = 0;
+    for (std::size_t k = 0; k < h1.rows.size(); ++k) {
+      scale = std::max(scale, std::abs(h1.rows[k][c]));
+      diff = std::max(diff, std::abs(h1.rows[k][c] - h2.rows[k][c]));
+    }
+    EXPECT_LE(diff, 1e-6 * std::max(scale, 1e-30)) << h1.columns[c];
+  }
+  const std::size_t drag = h1.column("drag_reaction_x_N");
+  ASSERT_LT(drag, h1.columns.size());
+  EXPECT_NEAR(h1.rows.back()[drag], 0.2 * 5.0, 0.02);
+  for (const auto& d : {fixed, moving, one}) fs::remove_all(d);
+}
+
 TEST(MpiRuns, ContactReachingTheEdgeOfTheHaloStopsTheRun) {
   if (!launcher_works()) GTEST_SKIP() << "the MPI launcher does not start here";
   const fs::path out = fresh_dir("mpi_halo_edge");

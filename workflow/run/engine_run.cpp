@@ -645,8 +645,27 @@ void log_end(const Run& r, const fem::ExplicitSolver& solver) {
         elem_cycles > 0 ? 1e9 * share * tm.internal_force / elem_cycles : 0.0,
         1e9 * r.loop_cpu / loop_ec);
   }
+  if (solver.domain() && solver.contact_halo_builds() > 0)
+    r.log->info(
+        "contact halo built again {} times as the surfaces moved (parallel.contact_halo_refresh "
+        "= {:.3g} of parallel.contact_halo = {:.3g} m)",
+        solver.contact_halo_builds(), solver.model().parallel.contact_halo_refresh,
+        solver.model().parallel.contact_halo);
   // Each counted contact's cost (bench_contact's figure: docs/performance.md), this rank's.
   const double cpu_share = r.loop_wall > 0 ? r.loop_cpu / r.loop_wall : 1.0;
+  // The cycle phase by phase, in the unit of the forming benchmark (bench_forming): ns of CPU
+  // per hexahedron-cycle of this rank, and the share of the loop.
+  if (const auto n_hex = static_cast<double>(solver.n_elements(fem::ElementKind::Hex8));
+      n_hex > 0 && r.loop_cycles > 0 && r.loop_wall > 0) {
+    std::string line;
+    const double per = 1e9 * cpu_share / (n_hex * static_cast<double>(r.loop_cycles));
+    for (const auto& [name, secs] : cycle_phases(solver))
+      if (secs > 0)
+        line += fmt::format("{}{} {:.1f} ({:.0f} %)", line.empty() ? "" : ", ", name, per * secs,
+                            100 * secs / r.loop_wall);
+    r.log->info("cycle{} in ns of CPU per hexahedron-cycle (share of the loop): {}",
+                solver.domain() ? " (rank 0)" : "", line);
+  }
   const auto& contacts = solver.model().contacts;
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const double nodes = static_cast<double>(contacts[k]->n_contact_nodes());

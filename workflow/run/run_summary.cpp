@@ -91,11 +91,14 @@ void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json
                          {"contact", tm.contact},
                          {"update", tm.update},
                          {"output", tm.output}};
+  auto& phases = summary["timers_s"]["phases"] = nlohmann::json::object();
+  for (const auto& [name, secs] : cycle_phases(solver)) phases[name] = secs;
   // Several ranks (docs/parallel.md): each rank's share, so that load imbalance shows.
   const auto& ranks = solver.rank_reports();
   summary["mpi_ranks"] = ranks.empty() ? 1 : ranks.size();
   if (!ranks.empty()) {
     summary["timers_s"]["exchange"] = tm.exchange;
+    summary["contact_halo_builds"] = solver.contact_halo_builds();
     auto& per = summary["mpi_per_rank"] = nlohmann::json::array();
     double busiest = 0;
     for (const auto& r : ranks)
@@ -174,6 +177,35 @@ void add_samples(const SummarySamples& ss, const RunHistory& h, json& summary) {
 void add_history_summary(const EngineCase& ec, const RunHistory& history, json& summary) {
   for (const auto& sm : ec.means) add_mean(sm, history, summary);
   for (const auto& ss : ec.samples) add_samples(ss, history, summary);
+}
+
+std::vector<std::pair<std::string, double>> cycle_phases(const fem::ExplicitSolver& s) {
+  std::vector<std::pair<std::string, double>> out;
+  const auto& tm = s.timers();
+  double elements = 0;
+  for (int k = 0; k < 3; ++k) {
+    const auto kind = static_cast<fem::ElementKind>(k);
+    double secs = 0;
+    bool any = false;
+    for (std::size_t g = 0; g < s.groups().size(); ++g)
+      if (s.groups()[g]->kind() == kind) secs += s.group_seconds(g), any = true;
+    if (any) out.emplace_back(fem::element_plural(kind), secs);
+    elements += secs;
+  }
+  out.emplace_back("erosion_and_step", std::max(tm.internal_force - elements, 0.0));
+  double counted = 0;
+  for (std::size_t k = 0; k < s.model().tools.size(); ++k) {
+    out.emplace_back("tool " + s.model().tools[k].name, s.tool_seconds(k));
+    counted += s.tool_seconds(k);
+  }
+  for (std::size_t k = 0; k < s.model().contacts.size(); ++k) {
+    out.emplace_back("contact " + s.model().contacts[k]->name(), s.contact_seconds(k));
+    counted += s.contact_seconds(k);
+  }
+  out.emplace_back("other_contact", std::max(tm.contact - counted, 0.0));
+  out.emplace_back("update", tm.update);
+  if (s.domain()) out.emplace_back("exchange", tm.exchange);
+  return out;
 }
 
 }  // namespace ncfsim::workflow

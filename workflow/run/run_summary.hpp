@@ -24,6 +24,12 @@ void describe_model(const fem::ExplicitSolver& s, spdlog::logger& log, nlohmann:
 /// "N hexahedra, M bars" over every element kind (for the log and `ncfsim check`).
 std::string element_counts(const fem::ExplicitSolver& s);
 
+/// Where this rank's time loop went, phase by phase (wall seconds, in cycle order): each element
+/// kind's internal forces, erosion checks and the step, each rigid tool, each contact (stitch
+/// joints among them), other contact forces (rigs' walls), the node update with the sums, and
+/// on several ranks the exchange. The phases add up to the loop less the output.
+std::vector<std::pair<std::string, double>> cycle_phases(const fem::ExplicitSolver& s);
+
 /// cycles, time reached, steps, the energy balance and its terms, hourglass ratio, erosion, timers.
 void add_state_summary(const fem::ExplicitSolver& s, double energy_balance_error_max,
                        nlohmann::json& summary);
