@@ -81,8 +81,9 @@ class ElementGroup {
 
   // Erosion (kinds that can lose elements; the defaults are for those that cannot).
   virtual bool can_erode() const { return false; }
-  /// Step of every element at x (1e300 for an eroded one) and, where asked, the smallest corner
-  /// Jacobian ratio of each (<= 0: folded over at a corner).
+  /// Step of every element of this rank's range at x (1e300 for an eroded one and, on several
+  /// ranks, for another rank's) and, where asked, the smallest corner Jacobian ratio of each
+  /// (<= 0: folded over at a corner).
   virtual void element_steps(const double* x, std::vector<double>& dt,
                              std::vector<double>* corner_jacobian) const {
     (void)x, (void)dt, (void)corner_jacobian;

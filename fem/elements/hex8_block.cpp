@@ -313,14 +313,16 @@ void hex8_lumped_mass(const Hex8Block& b, double* mass) {
 }
 
 void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt,
-                        std::vector<double>* corner_jacobian) {
+                        std::vector<double>* corner_jacobian, bool in_range) {
   // The three edges leaving each corner, right-handed (bottom face 0-3, top 4-7 above them).
   constexpr int kEdges[8][3] = {{1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7},
                                 {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}};
   dt.resize(b.n);
   if (corner_jacobian) corner_jacobian->resize(b.n);
+  const std::size_t e_begin = in_range ? std::min(b.n, b.range_begin) : 0;
+  const std::size_t e_end = in_range ? std::min(b.n, b.range_end) : b.n;
   for (std::size_t e = 0; e < b.n; ++e) {
-    if (b.n_eroded && b.eroded[e]) {
+    if ((b.n_eroded && b.eroded[e]) || e < e_begin || e >= e_end) {
       dt[e] = 1e300;
       if (corner_jacobian) (*corner_jacobian)[e] = 1.0;
       continue;

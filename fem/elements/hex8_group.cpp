@@ -59,7 +59,7 @@ class Hex8Group final : public ElementGroup {
   bool can_erode() const override { return true; }
   void element_steps(const double* x, std::vector<double>& dt,
                      std::vector<double>* corner_jacobian) const override {
-    hex8_element_steps(block, x, dt, corner_jacobian);
+    hex8_element_steps(block, x, dt, corner_jacobian, true);
   }
   void element_force(std::size_t e, const double* x, const double* v, double* f) const override {
     hex8_element_force(block, e, x, v, f);

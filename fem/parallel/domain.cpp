@@ -240,6 +240,17 @@ void Domain::gather_to_all(double* a) {
 }
 
 void Domain::build_exchange() {
+  readable_runs_.clear();
+  for (std::size_t i = 0; i < n_nodes_;) {
+    if (!readable_[i]) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < n_nodes_ && readable_[j]) ++j;
+    readable_runs_.emplace_back(i, j);
+    i = j;
+  }
   ghosts_.clear();
   for (std::size_t i = 0; i < n_nodes_; ++i)
     if (readable_[i] && !owned_[i]) ghosts_.push_back(static_cast<std::int32_t>(i));

@@ -56,6 +56,11 @@ class Domain {
 
   /// Nodes this rank reads (owned, corners of its elements, and those added by add_readable).
   const std::vector<std::uint8_t>& readable_mask() const { return readable_; }
+  /// Runs [begin, end) of consecutive readable nodes (after finalise): the only entries of a
+  /// nodal force array this rank writes or reads, so the only ones it clears each cycle.
+  const std::vector<std::pair<std::size_t, std::size_t>>& readable_runs() const {
+    return readable_runs_;
+  }
   /// Marks more nodes as read by this rank (before finalise()).
   void add_readable(std::span<const std::int32_t> nodes);
   /// Builds the ghost exchange (collective). No add_readable after it.
@@ -98,7 +103,7 @@ class Domain {
   std::vector<int> owner_;
   std::vector<std::uint8_t> owned_, readable_;
   std::vector<std::uint8_t> base_readable_;  // readable_ before add_readable (owned, elements)
-  std::vector<std::pair<std::size_t, std::size_t>> runs_;
+  std::vector<std::pair<std::size_t, std::size_t>> runs_, readable_runs_;
   std::vector<std::int32_t> ghosts_;
   std::vector<std::int32_t> shared_;  // owned nodes that other ranks read (ascending)
   PetscSF ghost_sf_ = nullptr;   // leaves: this rank's ghosts; roots: the owners' entries
