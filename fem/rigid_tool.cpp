@@ -286,10 +286,10 @@ void tool_contact_forces(RigidTool& tool, const double* x, const double* v, cons
   const double tool_moved = near.valid ? norm(tool.displacement - near.tool_ref) : 0.0;
   // The displacement check is needed only when the last one's largest displacement plus the
   // bound on the nodes' travel since could reach the margin (it would pass otherwise).
-  const bool check = near.valid && (node_travel < 0 || near.checked_travel < 0 ||
-                                    near.checked_d + (node_travel - near.checked_travel) +
-                                            tool_moved >=
-                                        near.margin);
+  const bool check =
+      near.valid &&
+      (node_travel < 0 || near.checked_travel < 0 ||
+       near.checked_d + (node_travel - near.checked_travel) + tool_moved >= near.margin);
   if (check) {  // can a node outside the near list have closed the margin since?
     double d2 = 0;
     const double* xr = near.x_ref.data();
