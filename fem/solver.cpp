@@ -797,6 +797,52 @@ void ExplicitSolver::refresh_contact_halo(double* x, double* v) {
   halo_due_ = false;
 }
 
+// Dynamic mass scaling: when the last cycle's step (the same on every rank) was set by a
+// hexahedron below time.mass_scaling_dt, every hexahedron of this rank below it gets the mass
+// that puts its step 5 % above (so that a locking element is not scaled every cycle), added to
+// its nodes; on several ranks the owners sum what their ghosts got. A free node that gains mass
+// keeps its kinetic energy (its velocity scaled by sqrt(m / (m + dm))): the added inertia brings
+// no energy of its own, and the momentum of those nodes drops by that factor (in quasi-static
+// forming a share of a small term). A node held at a prescribed velocity keeps it: the fixture
+// gives the added mass its kinetic energy, booked as its external work. The balance stays
+// closed; the added mass is reported per part.
+void ExplicitSolver::scale_mass_dynamic(double* x, double* v, double* m) {
+  const double target = model_.time.mass_scaling_dt, sf = model_.time.safety_factor;
+  if (cycle_ == 0 || step_.kind != ElementKind::Hex8 || !(sf * step_.dt < target)) return;
+  constexpr double kHeadroom = 1.05;
+  const std::size_t n = model_.mesh.n_nodes();
+  std::vector<double>& dm = added_mass_scratch_;
+  dm.assign(3 * n, 0.0);
+  std::vector<double> added(part_mass_.size(), 0.0);
+  for (const auto& g : groups_)
+    added[static_cast<std::size_t>(g->part())] +=
+        g->scale_mass_dynamic(x, target, sf, kHeadroom, dm.data());
+  if (domain_) {
+    domain_->add_ghosts_to_owners(dm.data(), nullptr);
+    MPI_Allreduce(MPI_IN_PLACE, added.data(), static_cast<int>(added.size()), MPI_DOUBLE, MPI_SUM,
+                  domain_->comm());
+  }
+  const auto scale = [&](std::size_t b, std::size_t e) {
+    for (std::size_t d = 3 * b; d < 3 * e; ++d) {
+      if (!(dm[d] > 0)) continue;
+      if (!fixed_mask_[d])
+        v[d] *= std::sqrt(m[d] / (m[d] + dm[d]));
+      else  // held at its velocity: the fixture gives the added mass its kinetic energy
+        mass_scaling_work_ += 0.5 * dm[d] * v[d] * v[d];
+      m[d] += dm[d];
+      if (inv_mass_[d] > 0) inv_mass_[d] = 1.0 / m[d];  // a freed node stays held (0)
+    }
+  };
+  if (domain_) {
+    for (const auto& [b, e] : domain_->owned_runs()) scale(b, e);
+    domain_->refresh_ghosts(x, v);  // the ghosts' velocities as their owners scaled them
+  } else {
+    scale(0, n);
+  }
+  for (std::size_t p = 0; p < added.size(); ++p) part_mass_[p].added_mass += added[p];
+  ++mass_scaling_events_;
+}
+
 // One cycle of central differences: the phases below in order, each reading what the ones before
 // left in `c`. The vectors' views are held over them and released before the callback, which may
 // read the vectors itself.
@@ -819,6 +865,11 @@ void ExplicitSolver::step(const std::function<void()>& at_tn, bool at_tn_reads_x
       const auto th = Clock::now();
       refresh_contact_halo(a.x, a.v);
       timers_.exchange += seconds_since(th);
+    }
+    if (model_.time.mass_scaling_dynamic) {
+      const auto tm = Clock::now();
+      scale_mass_dynamic(a.x, a.v, M.data());
+      timers_.internal_force += seconds_since(tm);
     }
     auto t0 = Clock::now();
     internal_forces(a, c);
@@ -1046,6 +1097,8 @@ void ExplicitSolver::update_velocities(const CycleArrays& a, Cycle& c) {
   // discrete energy balance of central differences exact for conservative forces.
   ext_old *= dtp, ext_new *= dt_new, damp_old *= dtp, damp_new *= dt_new, con_old *= dtp,
       con_new *= dt_new;
+  ext_old += 2.0 * mass_scaling_work_;  // booked whole in this cycle (WorkAccumulator halves it)
+  mass_scaling_work_ = 0;
   ke *= 0.5;
   const double inv_dt_mid = dt_mid > 0 ? 1.0 / dt_mid : 0.0;
   for (auto& m : motions_) m->velocities(c.t_half, motion_v_.data());
@@ -1277,6 +1330,14 @@ void ExplicitSolver::save_state(CheckpointWriter& w) const {
     auto V = v.view();
     w.write_array("x", std::span<const double>(X.data(), 3 * n));
     w.write_array("v", std::span<const double>(V.data(), 3 * n));
+    if (model_.time.mass_scaling_dynamic) {  // the masses added during the run
+      auto M = mass.view();
+      w.write_array("mass", std::span<const double>(M.data(), 3 * n));
+      std::vector<double> added;
+      for (const auto& pm : part_mass_) added.push_back(pm.added_mass);
+      save_array(w, "part_added_mass", added);
+      w.write_int("mass_scaling_events", mass_scaling_events_);
+    }
   }
   w.write_double("t", t_);
   w.write_double("dt", dt_);
@@ -1371,6 +1432,15 @@ void ExplicitSolver::load_state(CheckpointReader& r) {
     auto V = v.view();
     r.read_array("v", a, 3 * n);
     std::copy(a.begin(), a.end(), V.data());
+    if (r.has("mass")) {  // dynamic mass scaling: the masses as they stood (freed nodes below)
+      auto M = mass.view();
+      r.read_array("mass", a, 3 * n);
+      std::copy(a.begin(), a.end(), M.data());
+      for (std::size_t d = 0; d < 3 * n; ++d) inv_mass_[d] = 1.0 / M[d];
+      r.read_array("part_added_mass", a, part_mass_.size());
+      for (std::size_t p = 0; p < part_mass_.size(); ++p) part_mass_[p].added_mass = a[p];
+      mass_scaling_events_ = r.read_int("mass_scaling_events");
+    }
   }
   if (r.read_double("dt_initial") != dt_initial_)
     r.mismatch("dt_initial",
@@ -1395,6 +1465,7 @@ void ExplicitSolver::load_state(CheckpointReader& r) {
       acc[k]->committed = a[2 * k], acc[k]->pending = a[2 * k + 1];
     r.read_array("timers", a, 4);
     timers_ = {a[0], a[1], a[2], a[3]};
+    timers_loaded_ = timers_;
   }
   {
     CheckpointScope<CheckpointReader> er(r, "erosions");

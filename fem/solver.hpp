@@ -104,6 +104,13 @@ class ExplicitSolver {
   /// contact, their kinetic energy booked as EnergyBalance::eroded_kinetic.
   std::size_t n_freed_nodes() const { return n_freed_nodes_; }
   const PhaseTimers& timers() const { return timers_; }
+  /// The phase timers of this process's loop only (after a resume, less the saved ones), as
+  /// tool_seconds, contact_seconds and group_seconds count.
+  PhaseTimers loop_timers() const {
+    return {timers_.internal_force - timers_loaded_.internal_force,
+            timers_.contact - timers_loaded_.contact, timers_.update - timers_loaded_.update,
+            timers_.output - timers_loaded_.output, timers_.exchange - timers_loaded_.exchange};
+  }
   /// Seconds spent in contact k (model().contacts[k]) so far, part of timers().contact.
   double contact_seconds(std::size_t k) const {
     return k < contact_seconds_.size() ? contact_seconds_[k] : 0.0;
@@ -117,6 +124,8 @@ class ExplicitSolver {
   double group_seconds(std::size_t k) const {
     return k < group_seconds_.size() ? group_seconds_[k] : 0.0;
   }
+  /// Dynamic mass scaling (time.mass_scaling_dynamic): the cycles in which mass was added.
+  std::int64_t mass_scaling_events() const { return mass_scaling_events_; }
   /// Several ranks: how many times the contact halo was built again as the nodes moved
   /// (parallel.contact_halo_refresh; since the start or the resume).
   std::int64_t contact_halo_builds() const { return halo_builds_; }
@@ -291,6 +300,7 @@ class ExplicitSolver {
   // rigid tools' proximity cull compares its growth with their margin (not checkpointed: after a
   // resume the tools check once and start from there).
   double node_travel_ = 0;
+  PhaseTimers timers_loaded_;  // the timers a checkpoint brought (loop_timers)
   // Several ranks, the contact halo built again as the nodes move (refresh_contact_halo): the
   // positions at the last build, a bound on the largest node displacement since (summed over
   // the ranks each cycle, the same on all), the last exact check of it, and the builds so far.
@@ -299,6 +309,11 @@ class ExplicitSolver {
   bool halo_due_ = false;  // build at the next cycle (after a resume)
   std::int64_t halo_builds_ = 0;
   void refresh_contact_halo(double* x, double* v);
+  // Dynamic mass scaling (time.mass_scaling_dynamic): events so far and the work array.
+  std::int64_t mass_scaling_events_ = 0;
+  double mass_scaling_work_ = 0;  // this cycle's, on held nodes (booked as external work)
+  std::vector<double> added_mass_scratch_;
+  void scale_mass_dynamic(double* x, double* v, double* m);
   std::vector<V3> vpres_;         // prescribed velocities at t^{n+1/2}, one per set
   std::vector<double> motion_v_;  // per constrained DOF: velocity from its boundary motion
   bool has_motion_forces_ = false;

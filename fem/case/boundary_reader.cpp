@@ -117,6 +117,10 @@ void read_time(CaseReadContext& ctx) {
   time.end_time = tc.number("end_time", Range::positive());
   time.safety_factor = tc.number("safety_factor", 0.9, Range::open_closed(0, 1));
   time.mass_scaling_dt = tc.number("mass_scaling_dt", 0.0, Range::non_negative());
+  time.mass_scaling_dynamic = tc.boolean("mass_scaling_dynamic", false);
+  if (time.mass_scaling_dynamic && !(time.mass_scaling_dt > 0))
+    tc.fail("mass_scaling_dynamic",
+            "dynamic mass scaling needs its target step: set time.mass_scaling_dt > 0");
   time.history_interval = tc.number("history_interval", time.end_time / 200, Range::positive());
   time.frame_interval = tc.number("frame_interval", time.end_time / 20, Range::positive());
   time.max_cycles = tc.integer("max_cycles", 0, 0, std::int64_t{1} << 50);

@@ -53,6 +53,15 @@ class ElementGroup {
   virtual void add_part_mass(double& mass, double& added_mass) const = 0;
   /// Adds mass where an element's step (times safety) is below target_dt, so that it reaches it.
   virtual void scale_mass(const double* x, double target_dt, double safety) = 0;
+  /// Dynamic mass scaling: each element of this rank's range whose step at x (times safety) is
+  /// below 1.02 target_dt gets the density that puts it at `headroom` times target_dt; its added
+  /// mass goes to its nodes in dm [3*n_nodes] (an eighth each for a hexahedron). Returns the mass
+  /// added (kg). Kinds that do not scale during a run add nothing.
+  virtual double scale_mass_dynamic(const double* x, double target_dt, double safety,
+                                    double headroom, double* dm) {
+    (void)x, (void)target_dt, (void)safety, (void)headroom, (void)dm;
+    return 0.0;
+  }
   /// Stable step of the group's controlling element at positions x.
   virtual StableStep stable_step(const double* x) const = 0;
   /// Internal forces subtracted from f [3*n_nodes]; energy increments accumulated, step lowered to

@@ -36,6 +36,26 @@ class Hex8Group final : public ElementGroup {
     for (std::size_t e = 0; e < block.n; ++e)
       if (sf * dt[e] < target) block.density[e] *= std::pow(target / (sf * dt[e]), 2);
   }
+  double scale_mass_dynamic(const double* x, double target, double sf, double headroom,
+                            double* dm) override {
+    std::vector<double> dt;
+    hex8_element_steps(block, x, dt, nullptr, true);
+    double added = 0;
+    for (std::size_t e = 0; e < block.n; ++e) {
+      // Below the target, or within 2 % of it: elements closing on it together are scaled
+      // together, not one event each (out of range or eroded: 1e300).
+      if (!(sf * dt[e] < 1.02 * target)) continue;
+      const double factor = std::pow(headroom * target / (sf * dt[e]), 2);
+      const double m = (factor - 1) * block.density[e] * block.volume0[e];
+      block.density[e] *= factor;
+      added += m;
+      for (int I = 0; I < 8; ++I) {
+        const auto node = static_cast<std::size_t>(block.conn[I * block.n + e]);
+        for (int c = 0; c < 3; ++c) dm[3 * node + c] += m / 8.0;
+      }
+    }
+    return added;
+  }
   StableStep stable_step(const double* x) const override { return hex8_stable_step(block, x); }
   void internal_forces(const ElementCycleState& s, double* f, ElementEnergyIncrement& energy,
                        StableStep& step) override {
@@ -89,6 +109,7 @@ class Hex8Group final : public ElementGroup {
     save_array(w, "hg_viscous", block.hg_viscous);
     save_array(w, "volume", block.volume);
     save_array(w, "eroded", block.eroded);  // empty: none eroded yet
+    save_array(w, "density", block.density);  // mass scaling, static and dynamic
   }
   void load_state(CheckpointReader& r) override {
     load_array(r, "stress", block.stress);
@@ -97,6 +118,7 @@ class Hex8Group final : public ElementGroup {
     load_array(r, "hg_force", block.hg_force);
     load_array(r, "hg_viscous", block.hg_viscous);
     load_array(r, "volume", block.volume);
+    if (r.has("density")) load_array(r, "density", block.density);
     r.read_array("eroded", block.eroded);
     if (!block.eroded.empty() && block.eroded.size() != block.n)
       r.mismatch("eroded", "has " + std::to_string(block.eroded.size()) +

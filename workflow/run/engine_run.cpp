@@ -645,6 +645,14 @@ void log_end(const Run& r, const fem::ExplicitSolver& solver) {
         elem_cycles > 0 ? 1e9 * share * tm.internal_force / elem_cycles : 0.0,
         1e9 * r.loop_cpu / loop_ec);
   }
+  if (solver.model().time.mass_scaling_dynamic) {
+    r.log->info("dynamic mass scaling: mass added in {} cycles (hexahedra below {:.4g} s)",
+                solver.mass_scaling_events(), solver.model().time.mass_scaling_dt);
+    for (const auto& pm : solver.part_masses())
+      r.log->info("  part {:<16} mass {:.5g} kg, added by mass scaling {:.5g} kg ({:.3g} %)",
+                  pm.part, pm.mass, pm.added_mass,
+                  pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0);
+  }
   if (solver.domain() && solver.contact_halo_builds() > 0)
     r.log->info(
         "contact halo built again {} times as the surfaces moved (parallel.contact_halo_refresh "

@@ -72,6 +72,20 @@ void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json
   summary["time_step_final_s"] = solver.time_step();
   summary["energy_balance_error"] = en.error();
   summary["energy_balance_error_max"] = max_error;
+  if (solver.model().time.mass_scaling_dynamic) {
+    // Mass is only ever added: the share now is also the largest of the run.
+    json ratio = json::object();
+    for (const auto& pm : solver.part_masses()) {
+      ratio[pm.part] = pm.mass > 0 ? pm.added_mass / pm.mass : 0.0;
+      if (summary.contains("parts") && summary["parts"].contains(pm.part)) {
+        summary["parts"][pm.part]["added_mass_kg"] = pm.added_mass;
+        summary["parts"][pm.part]["added_mass_percent"] =
+            pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0;
+      }
+    }
+    summary["added_mass_ratio"] = ratio;
+    summary["mass_scaling_events"] = solver.mass_scaling_events();
+  }
   summary["kinetic_energy_J"] = en.kinetic;
   summary["internal_energy_J"] = en.internal;
   summary["stabilisation_energy_J"] = en.stabilisation;
@@ -181,7 +195,7 @@ void add_history_summary(const EngineCase& ec, const RunHistory& history, json& 
 
 std::vector<std::pair<std::string, double>> cycle_phases(const fem::ExplicitSolver& s) {
   std::vector<std::pair<std::string, double>> out;
-  const auto& tm = s.timers();
+  const fem::PhaseTimers tm = s.loop_timers();
   double elements = 0;
   for (int k = 0; k < 3; ++k) {
     const auto kind = static_cast<fem::ElementKind>(k);
@@ -192,7 +206,7 @@ std::vector<std::pair<std::string, double>> cycle_phases(const fem::ExplicitSolv
     if (any) out.emplace_back(fem::element_plural(kind), secs);
     elements += secs;
   }
-  out.emplace_back("erosion_and_step", std::max(tm.internal_force - elements, 0.0));
+  out.emplace_back("clear_erosion_step", std::max(tm.internal_force - elements, 0.0));
   double counted = 0;
   for (std::size_t k = 0; k < s.model().tools.size(); ++k) {
     out.emplace_back("tool " + s.model().tools[k].name, s.tool_seconds(k));

@@ -25,9 +25,10 @@ void describe_model(const fem::ExplicitSolver& s, spdlog::logger& log, nlohmann:
 std::string element_counts(const fem::ExplicitSolver& s);
 
 /// Where this rank's time loop went, phase by phase (wall seconds, in cycle order): each element
-/// kind's internal forces, erosion checks and the step, each rigid tool, each contact (stitch
-/// joints among them), other contact forces (rigs' walls), the node update with the sums, and
-/// on several ranks the exchange. The phases add up to the loop less the output.
+/// kind's internal forces, clearing the force arrays with the erosion checks and the step, each
+/// rigid tool, each contact (stitch joints among them), other contact forces (rigs' walls), the
+/// node update with the sums, and on several ranks the exchange. The phases add up to the loop less
+/// the output.
 std::vector<std::pair<std::string, double>> cycle_phases(const fem::ExplicitSolver& s);
 
 /// cycles, time reached, steps, the energy balance and its terms, hourglass ratio, erosion, timers.
