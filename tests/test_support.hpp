@@ -50,6 +50,24 @@ inline void add_elastic_block(fem::Model& model, const std::string& part,
   model.parts[static_cast<std::size_t>(p)].material = static_cast<int>(model.materials.size()) - 1;
 }
 
+/// Two cubes of side h stacked along z (no hourglass viscosity): the base held, the middle plane
+/// driven down at speed v, so the lower cube is crushed in uniaxial strain while the upper one
+/// rides on it (test_erosion.cpp, test_mass_scaling.cpp). Returns the base nodes.
+inline std::vector<std::int32_t> add_crushed_column(fem::Model& model, double h, double rho,
+                                                    double E, double nu, double v) {
+  add_elastic_block(model, "column", {0, 0, 0}, {h, h, 2 * h}, {1, 1, 2}, rho, E, nu);
+  model.parts[0].hourglass_viscosity = 0.0;
+  const auto base = nodes_at(model.mesh, 2, 0.0);
+  model.fixed.push_back({"base", base, {true, true, true}});
+  fem::PrescribedVelocity pv;
+  pv.name = "crush";
+  pv.nodes = nodes_at(model.mesh, 2, h);
+  pv.dofs = {true, true, true};
+  pv.velocity = {0, 0, -v};
+  model.velocities.push_back(pv);
+  return base;
+}
+
 /// A fixed rigid plane through `point` (normal `axis`, the body on its side) touching `nodes`.
 inline fem::RigidTool& add_rigid_plane(fem::Model& model, const std::string& name, fem::V3 point,
                                        fem::V3 axis, std::vector<std::int32_t> nodes,

@@ -86,6 +86,22 @@ PetscSF node_sf(MPI_Comm comm, std::size_t n_nodes, const std::vector<std::int32
   return sf;
 }
 
+// Runs [begin, end) of consecutive set entries of a node mask.
+std::vector<std::pair<std::size_t, std::size_t>> runs_of(const std::vector<std::uint8_t>& mask) {
+  std::vector<std::pair<std::size_t, std::size_t>> runs;
+  for (std::size_t i = 0; i < mask.size();) {
+    if (!mask[i]) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < mask.size() && mask[j]) ++j;
+    runs.emplace_back(i, j);
+    i = j;
+  }
+  return runs;
+}
+
 }  // namespace
 
 Domain::Domain(MPI_Comm comm, std::size_t n_nodes, const double* x0,
@@ -162,16 +178,7 @@ Domain::Domain(MPI_Comm comm, std::size_t n_nodes, const double* x0,
     if (owner_[i] == size_) owner_[i] = 0;  // no element: the root keeps it
     if (owner_[i] == rank_) owned_[i] = readable_[i] = 1, ++n_owned_;
   }
-  for (std::size_t i = 0; i < n_nodes;) {
-    if (!owned_[i]) {
-      ++i;
-      continue;
-    }
-    std::size_t j = i;
-    while (j < n_nodes && owned_[j]) ++j;
-    runs_.emplace_back(i, j);
-    i = j;
-  }
+  runs_ = runs_of(owned_);
   // Read: the nodes of my elements, and of every element on a node I own (a contact on an owned
   // surface node looks at the faces round it, whoever integrates them).
   for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -210,11 +217,7 @@ void Domain::add_readable(std::span<const std::int32_t> nodes) {
 
 void Domain::finalise() {
   if (base_readable_.empty()) base_readable_ = readable_;
-  std::vector<std::int32_t> remote;
-  if (root())
-    for (std::size_t i = 0; i < n_nodes_; ++i)
-      if (!owned_[i]) remote.push_back(static_cast<std::int32_t>(i));
-  gather_sf_ = node_sf(comm_, n_nodes_, remote, owner_);
+  gather_sf_ = node_sf(comm_, n_nodes_, root() ? not_owned() : std::vector<std::int32_t>{}, owner_);
   build_exchange();
 }
 
@@ -229,28 +232,20 @@ void Domain::rebuild_ghosts(std::span<const std::int32_t> extra, double* x, doub
 }
 
 void Domain::gather_to_all(double* a) {
-  if (!all_sf_) {
-    std::vector<std::int32_t> remote;
-    for (std::size_t i = 0; i < n_nodes_; ++i)
-      if (!owned_[i]) remote.push_back(static_cast<std::int32_t>(i));
-    all_sf_ = node_sf(comm_, n_nodes_, remote, owner_);
-  }
+  if (!all_sf_) all_sf_ = node_sf(comm_, n_nodes_, not_owned(), owner_);
   NCF_PETSC(PetscSFBcastBegin(all_sf_, node3_, a, a, MPI_REPLACE));
   NCF_PETSC(PetscSFBcastEnd(all_sf_, node3_, a, a, MPI_REPLACE));
 }
 
+std::vector<std::int32_t> Domain::not_owned() const {
+  std::vector<std::int32_t> nodes;
+  for (std::size_t i = 0; i < n_nodes_; ++i)
+    if (!owned_[i]) nodes.push_back(static_cast<std::int32_t>(i));
+  return nodes;
+}
+
 void Domain::build_exchange() {
-  readable_runs_.clear();
-  for (std::size_t i = 0; i < n_nodes_;) {
-    if (!readable_[i]) {
-      ++i;
-      continue;
-    }
-    std::size_t j = i;
-    while (j < n_nodes_ && readable_[j]) ++j;
-    readable_runs_.emplace_back(i, j);
-    i = j;
-  }
+  readable_runs_ = runs_of(readable_);
   ghosts_.clear();
   for (std::size_t i = 0; i < n_nodes_; ++i)
     if (readable_[i] && !owned_[i]) ghosts_.push_back(static_cast<std::int32_t>(i));

@@ -110,6 +110,7 @@ class Domain {
   PetscSF gather_sf_ = nullptr;  // leaves (root only): nodes the root does not own
   PetscSF all_sf_ = nullptr;     // leaves: every node this rank does not own (gather_to_all)
   void build_exchange();         // ghosts_, ghost_sf_, shared_, exchange_sf_ from readable_
+  std::vector<std::int32_t> not_owned() const;  // the nodes another rank owns, ascending
   // The per-cycle exchange on packed buffers: leaf k is ghosts_[k], root k is shared_[k].
   PetscSF exchange_sf_ = nullptr;
   mutable std::vector<double> leaf_buf_, root_buf_;  // [6 * ghosts], [6 * shared]

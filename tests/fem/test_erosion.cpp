@@ -19,16 +19,7 @@ constexpr double kH = 0.01, kRho = 1000, kE = 1e6, kNu = 0.3, kV = 0.05, kRatio 
 
 TEST(HexErosion, CrushedElementIsErodedAtTheStepRatio) {
   fem::Model model;
-  test::add_elastic_block(model, "column", {0, 0, 0}, {kH, kH, 2 * kH}, {1, 1, 2}, kRho, kE, kNu);
-  model.parts[0].hourglass_viscosity = 0.0;
-  const auto base = test::nodes_at(model.mesh, 2, 0.0), middle = test::nodes_at(model.mesh, 2, kH);
-  model.fixed.push_back({"base", base, {true, true, true}});
-  fem::PrescribedVelocity pv;
-  pv.name = "crush";
-  pv.nodes = middle;
-  pv.dofs = {true, true, true};
-  pv.velocity = {0, 0, -kV};
-  model.velocities.push_back(pv);
+  const auto base = test::add_crushed_column(model, kH, kRho, kE, kNu, kV);
   model.time.end_time = 1.0;
   model.time.erosion_step_ratio = kRatio;
 

@@ -26,16 +26,7 @@ constexpr double kH = 0.01, kRho = 1000, kE = 1e6, kNu = 0.3, kV = 0.05;
 
 TEST(DynamicMassScaling, CrushedElementKeepsTheTargetStepWithTheMassItNeeds) {
   fem::Model model;
-  test::add_elastic_block(model, "column", {0, 0, 0}, {kH, kH, 2 * kH}, {1, 1, 2}, kRho, kE, kNu);
-  model.parts[0].hourglass_viscosity = 0.0;
-  const auto base = test::nodes_at(model.mesh, 2, 0.0), middle = test::nodes_at(model.mesh, 2, kH);
-  model.fixed.push_back({"base", base, {true, true, true}});
-  fem::PrescribedVelocity pv;
-  pv.name = "crush";
-  pv.nodes = middle;
-  pv.dofs = {true, true, true};
-  pv.velocity = {0, 0, -kV};
-  model.velocities.push_back(pv);
+  test::add_crushed_column(model, kH, kRho, kE, kNu, kV);
   const double c = std::sqrt(kE / (1 - 2 * kNu) / kRho);  // the step's modulus 3K
   const double sf = 0.9, dt0 = sf * kH / c;
   model.time.safety_factor = sf;

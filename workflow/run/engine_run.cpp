@@ -648,10 +648,7 @@ void log_end(const Run& r, const fem::ExplicitSolver& solver) {
   if (solver.model().time.mass_scaling_dynamic) {
     r.log->info("dynamic mass scaling: mass added in {} cycles (hexahedra below {:.4g} s)",
                 solver.mass_scaling_events(), solver.model().time.mass_scaling_dt);
-    for (const auto& pm : solver.part_masses())
-      r.log->info("  part {:<16} mass {:.5g} kg, added by mass scaling {:.5g} kg ({:.3g} %)",
-                  pm.part, pm.mass, pm.added_mass,
-                  pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0);
+    log_part_masses(solver, *r.log);
   }
   if (solver.domain() && solver.contact_halo_builds() > 0)
     r.log->info(

@@ -31,6 +31,21 @@ json summary_header(const EngineCase& ec, const RunOptions& options) {
   return summary;
 }
 
+namespace {
+// A part's entry under summary.json "parts" (its masses as they stand).
+json part_mass_entry(const fem::PartMassReport& pm) {
+  return {{"mass_kg", pm.mass},
+          {"added_mass_kg", pm.added_mass},
+          {"added_mass_percent", pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0}};
+}
+}  // namespace
+
+void log_part_masses(const fem::ExplicitSolver& s, spdlog::logger& log) {
+  for (const auto& pm : s.part_masses())
+    log.info("  part {:<16} mass {:.5g} kg, added by mass scaling {:.5g} kg ({:.3g} %)", pm.part,
+             pm.mass, pm.added_mass, pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0);
+}
+
 void describe_model(const fem::ExplicitSolver& solver, spdlog::logger& log, json& summary) {
   const fem::Model& model = solver.model();
   log.info("mesh: {} nodes, {}, {} parts, {} tools", model.mesh.n_nodes(), element_counts(solver),
@@ -38,14 +53,9 @@ void describe_model(const fem::ExplicitSolver& solver, spdlog::logger& log, json
   const auto& st = solver.controlling_element();
   log.info("stable step {:.4g} s (safety factor {}), controlled by {} {}", solver.time_step(),
            model.time.safety_factor, fem::element_noun(st.kind), st.element);
+  log_part_masses(solver, log);
   json parts = json::object();
-  for (const auto& pm : solver.part_masses()) {
-    const double pct = pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0;
-    log.info("  part {:<16} mass {:.5g} kg, added by mass scaling {:.5g} kg ({:.3g} %)", pm.part,
-             pm.mass, pm.added_mass, pct);
-    parts[pm.part] = {
-        {"mass_kg", pm.mass}, {"added_mass_kg", pm.added_mass}, {"added_mass_percent", pct}};
-  }
+  for (const auto& pm : solver.part_masses()) parts[pm.part] = part_mass_entry(pm);
   for (const auto& t : model.tools)
     if (t.motion.pressure > 0) {
       log.info("tool {}: {:.4g} Pa over the {:.5g} m^2 of blank it covers: {:.5g} N", t.name,
@@ -77,11 +87,8 @@ void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json
     json ratio = json::object();
     for (const auto& pm : solver.part_masses()) {
       ratio[pm.part] = pm.mass > 0 ? pm.added_mass / pm.mass : 0.0;
-      if (summary.contains("parts") && summary["parts"].contains(pm.part)) {
-        summary["parts"][pm.part]["added_mass_kg"] = pm.added_mass;
-        summary["parts"][pm.part]["added_mass_percent"] =
-            pm.mass > 0 ? 100.0 * pm.added_mass / pm.mass : 0.0;
-      }
+      if (summary.contains("parts") && summary["parts"].contains(pm.part))
+        summary["parts"][pm.part] = part_mass_entry(pm);
     }
     summary["added_mass_ratio"] = ratio;
     summary["mass_scaling_events"] = solver.mass_scaling_events();

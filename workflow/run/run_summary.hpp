@@ -24,6 +24,9 @@ void describe_model(const fem::ExplicitSolver& s, spdlog::logger& log, nlohmann:
 /// "N hexahedra, M bars" over every element kind (for the log and `ncfsim check`).
 std::string element_counts(const fem::ExplicitSolver& s);
 
+/// One log line per part: its physical mass and the mass added by mass scaling so far.
+void log_part_masses(const fem::ExplicitSolver& s, spdlog::logger& log);
+
 /// Where this rank's time loop went, phase by phase (wall seconds, in cycle order): each element
 /// kind's internal forces, clearing the force arrays with the erosion checks and the step, each
 /// rigid tool, each contact (stitch joints among them), other contact forces (rigs' walls), the
