@@ -761,40 +761,52 @@ void ExplicitSolver::throw_blow_up_of(int from, const std::string& what) const {
 void ExplicitSolver::refresh_contact_halo(double* x, double* v) {
   const double share = model_.parallel.contact_halo_refresh;
   if (share <= 0) return;
-  const double reach = 0.5 * share * model_.parallel.contact_halo;
-  if (!halo_due_ && halo_checked_d_ + (halo_travel_ - halo_travel_checked_) < reach) return;
-  double d = 0;
-  if (!halo_due_) {
-    double d2 = 0;
-    for (const auto& [b, e] : domain_->owned_runs())
-      for (std::size_t i = b; i < e; ++i) {
-        const double dx = x[3 * i] - halo_x_[3 * i], dy = x[3 * i + 1] - halo_x_[3 * i + 1],
-                     dz = x[3 * i + 2] - halo_x_[3 * i + 2];
-        d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
-      }
-    d = std::sqrt(d2);
-    MPI_Allreduce(MPI_IN_PLACE, &d, 1, MPI_DOUBLE, MPI_MAX, domain_->comm());
-    if (d < reach) {
-      halo_checked_d_ = d, halo_travel_checked_ = halo_travel_;
-      return;
+  if (halo_due_) {  // a resume: the halo of the last build, at the positions it was built at
+    if (halo_x_.empty()) {  // a checkpoint without them: at the saved positions
+      domain_->gather_to_all(x);
+      halo_x_.assign(x, x + 3 * model_.mesh.n_nodes());
+      halo_travel_ = halo_checked_d_ = halo_travel_checked_ = 0;
     }
+    build_contact_halo(x, v);
+    halo_due_ = false;
+    return;
+  }
+  const double reach = 0.5 * share * model_.parallel.contact_halo;
+  if (halo_checked_d_ + (halo_travel_ - halo_travel_checked_) < reach) return;
+  double d2 = 0;
+  for (const auto& [b, e] : domain_->owned_runs())
+    for (std::size_t i = b; i < e; ++i) {
+      const double dx = x[3 * i] - halo_x_[3 * i], dy = x[3 * i + 1] - halo_x_[3 * i + 1],
+                   dz = x[3 * i + 2] - halo_x_[3 * i + 2];
+      d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
+    }
+  double d = std::sqrt(d2);
+  MPI_Allreduce(MPI_IN_PLACE, &d, 1, MPI_DOUBLE, MPI_MAX, domain_->comm());
+  if (d < reach) {
+    halo_checked_d_ = d, halo_travel_checked_ = halo_travel_;
+    return;
   }
   // Every node's position from its owner (a rank's copies of the nodes it does not read are
-  // stale), the halo at those positions, the ghosts that go with it.
+  // stale), the halo at those positions.
   domain_->gather_to_all(x);
+  halo_x_.assign(x, x + 3 * model_.mesh.n_nodes());
+  halo_travel_ = halo_checked_d_ = halo_travel_checked_ = 0;
+  build_contact_halo(x, v);
+  ++halo_builds_;
+}
+
+// The contacts' halo at the positions halo_x_, and the ghosts that go with it (x, v refreshed).
+void ExplicitSolver::build_contact_halo(double* x, double* v) {
   std::vector<std::int32_t> extra, part;
   for (auto& c : model_.contacts) {
     part.clear();
-    c->nodes_to_read(domain_->owned_mask().data(), x, model_.parallel.contact_halo, part);
+    c->nodes_to_read(domain_->owned_mask().data(), halo_x_.data(), model_.parallel.contact_halo,
+                     part);
     extra.insert(extra.end(), part.begin(), part.end());
   }
   domain_->rebuild_ghosts(extra, x, v);
   for (auto& c : model_.contacts)
     c->restrict_to_rank(domain_->owned_mask().data(), domain_->readable_mask().data());
-  halo_x_.assign(x, x + 3 * model_.mesh.n_nodes());
-  halo_travel_ = halo_checked_d_ = halo_travel_checked_ = 0;
-  if (!halo_due_) ++halo_builds_;  // the build at a resume is not counted: as uninterrupted
-  halo_due_ = false;
 }
 
 // Dynamic mass scaling: when the last cycle's step (the same on every rank) was set by a
@@ -1345,6 +1357,11 @@ void ExplicitSolver::save_state(CheckpointWriter& w) const {
   w.write_double("dt_initial", dt_initial_);
   w.write_int("cycle", cycle_);
   w.write_int("contact_halo_builds", halo_builds_);
+  if (!halo_x_.empty()) {  // several ranks: the halo's last build, so a resume rebuilds it
+    save_array(w, "halo_x", halo_x_);
+    save_array(w, "halo_travel",
+               std::vector<double>{halo_travel_, halo_checked_d_, halo_travel_checked_});
+  }
   w.write_double("step_dt", step_.dt);
   w.write_int("step_element", step_.element);
   w.write_int("step_kind", static_cast<std::int64_t>(step_.kind));
@@ -1451,6 +1468,13 @@ void ExplicitSolver::load_state(CheckpointReader& r) {
   dt_prev_ = r.read_double("dt_prev");
   cycle_ = r.read_int("cycle");
   halo_builds_ = r.has("contact_halo_builds") ? r.read_int("contact_halo_builds") : 0;
+  halo_x_.clear();  // none saved: built at the saved positions
+  if (halo_due_ && r.has("halo_x")) {
+    std::vector<double> tr;
+    r.read_array("halo_x", halo_x_, 3 * n);
+    r.read_array("halo_travel", tr, 3);
+    halo_travel_ = tr[0], halo_checked_d_ = tr[1], halo_travel_checked_ = tr[2];
+  }
   step_.dt = r.read_double("step_dt");
   step_.element = r.read_int("step_element");
   step_.kind = static_cast<ElementKind>(r.read_int("step_kind"));

@@ -306,9 +306,10 @@ class ExplicitSolver {
   // the ranks each cycle, the same on all), the last exact check of it, and the builds so far.
   std::vector<double> halo_x_;
   double halo_travel_ = 0, halo_checked_d_ = 0, halo_travel_checked_ = 0, node_travel_sent_ = 0;
-  bool halo_due_ = false;  // build at the next cycle (after a resume)
+  bool halo_due_ = false;  // after a resume: rebuild the last build's halo at the next cycle
   std::int64_t halo_builds_ = 0;
   void refresh_contact_halo(double* x, double* v);
+  void build_contact_halo(double* x, double* v);
   // Dynamic mass scaling (time.mass_scaling_dynamic): events so far and the work array.
   std::int64_t mass_scaling_events_ = 0;
   double mass_scaling_work_ = 0;  // this cycle's, on held nodes (booked as external work)

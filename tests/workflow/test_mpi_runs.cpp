@@ -218,7 +218,8 @@ TEST(MpiRuns, BlowUpOnOneRankStopsEveryRankWithItsReport) {
 // (tests/cases/mpi/sliding_block.toml): with the contact halo fixed at the start it slides past
 // the segments its rank reads and the run stops (exit 3); built again as the nodes move (the
 // default parallel.contact_halo_refresh) the run ends on 2 ranks as on 1: every history column
-// within 1e-6 of its scale (round-off of the sums' order), and the drag is mu P = 0.2 x 5 N.
+// within 1e-6 of its scale (round-off of the sums' order), and the drag is mu P = 0.2 x 5 N;
+// stopped half-way and resumed, the same history and builds.
 TEST(MpiRuns, ContactHaloIsBuiltAgainAsTheSurfacesSlide) {
   if (!launcher_works()) GTEST_SKIP() << "the MPI launcher does not start here";
   const fs::path file = kSource / "tests/cases/mpi/sliding_block.toml";
@@ -253,7 +254,19 @@ TEST(MpiRuns, ContactHaloIsBuiltAgainAsTheSurfacesSlide) {
   const std::size_t drag = h1.column("drag_reaction_x_N");
   ASSERT_LT(drag, h1.columns.size());
   EXPECT_NEAR(h1.rows.back()[drag], 0.2 * 5.0, 0.02);
-  for (const auto& d : {fixed, moving, one}) fs::remove_all(d);
+  // Stopped half-way through the slide (14 builds done) and resumed: the checkpoint keeps the
+  // last build's positions, so the same builds follow and the history is the same bit for bit.
+  const fs::path resumed = fresh_dir("mpi_halo_resumed");
+  const Result rs = run_cli(
+      {"run", file.string(), "-o", resumed.string(), "--np", "2", "--set", "time.max_cycles=2237"});
+  EXPECT_EQ(rs.code, 1) << rs.output;
+  const Result rr = run_cli({"run", file.string(), "-o", resumed.string(), "--np", "2", "--set",
+                             "time.max_cycles=100000", "--resume"});
+  ASSERT_EQ(rr.code, 0) << rr.output;
+  EXPECT_EQ(slurp(moving / "history.csv"), slurp(resumed / "history.csv"));
+  const auto sr = nlohmann::json::parse(slurp(resumed / "summary.json"));
+  EXPECT_EQ(sr["contact_halo_builds"], s["contact_halo_builds"]);
+  for (const auto& d : {fixed, moving, one, resumed}) fs::remove_all(d);
 }
 
 TEST(MpiRuns, ContactReachingTheEdgeOfTheHaloStopsTheRun) {
