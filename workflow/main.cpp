@@ -1,4 +1,5 @@
-// ncfsim: the command line (docs/cli.md). Subcommands run, check, render, report.
+// ncfsim: the command line (docs/cli.md). Subcommands run, check, status, render, report, export,
+// calibrate, compare.
 // Exit codes: 0 success, 1 other error (incl. an interrupted run), 2 bad input, 3 numerical
 // failure.
 #include <spdlog/spdlog.h>
@@ -26,6 +27,7 @@
 #include "workflow/case/engine_case.hpp"
 #include "workflow/compare/compare.hpp"
 #include "workflow/figures/figures.hpp"
+#include "workflow/output/run_status.hpp"
 #include "workflow/report/report.hpp"
 #include "workflow/run/engine_run.hpp"
 #include "workflow/run/mpi_launch.hpp"
@@ -143,6 +145,11 @@ int main(int argc, char** argv) {
   auto* render =
       app.add_subcommand("render", "(Re)draw the figures of a finished run (off-screen)");
   render->add_option("outdir", folder, "Output folder of a run")->required();
+  auto* status = app.add_subcommand(
+      "status",
+      "Say how a run or workflow in an output folder stands (running, completed, failed, ...); "
+      "a summary that still says running with no process holding the folder becomes killed");
+  status->add_option("outdir", folder, "Output folder of a run or workflow")->required();
   auto* report = app.add_subcommand("report", "Write report.html for a finished run");
   report->add_option("outdir", folder, "Output folder of a run")->required();
   std::string deck_format;
@@ -368,6 +375,7 @@ int main(int argc, char** argv) {
     }
     if (*render) {
       require_output_folder(folder);
+      const auto lock = wf::FolderLock::acquire(folder, "render");  // not while a run writes
       auto log = wf::make_run_logger({}, verbosity);
       const auto pngs = wf::render_figures(folder, *log);
       wf::OutputFolder::record(folder, pngs);
@@ -376,14 +384,23 @@ int main(int argc, char** argv) {
     }
     if (*exporter) {
       require_output_folder(folder);
+      const auto lock = wf::FolderLock::acquire(folder, "export");
       const auto r = wf::export_impregnated(folder, deck_format);
       wf::OutputFolder::record(folder, {r.file});
       std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs, %zu stitch bars\n",
                   r.file.c_str(), r.nodes, r.elements, r.materials, r.tie_pairs, r.bars);
       return wf::kSuccess;
     }
+    if (*status) {
+      require_output_folder(folder);
+      for (const auto& f : wf::folder_status(folder))
+        std::printf("%s: %s%s\n", f.dir.c_str(), f.stage == "engine" ? "" : (f.stage + " ").c_str(),
+                    f.line.c_str());
+      return wf::kSuccess;
+    }
     if (*report) {
       require_output_folder(folder);
+      const auto lock = wf::FolderLock::acquire(folder, "report");
       const auto js = wf::read_json_file(std::filesystem::path(folder) / "summary.json");
       if (js.is_object() && js.value("stage", "") == "workflow")
         wf::write_workflow_report(folder);

@@ -71,6 +71,14 @@ KinematicDrapeCase load_kinematic_drape_case(const std::filesystem::path& file,
   if (gap < 0)
     root.fail("net.pole", "lies inside a [[surface]] body (gap " + std::to_string(gap) +
                               " m): start the net outside the tool");
+  // The pole is the net's highest point along the ring axis (the net lies on the tool below it):
+  // a ring at or above it meets nothing.
+  const double pole_height = dot(kc.net.pole - kc.ring.centre, kc.ring.axis);
+  if (kc.ring.height >= pole_height)
+    root.fail("ring.height", std::to_string(kc.ring.height) + " m is at or above the net's pole (" +
+                                 std::to_string(pole_height) +
+                                 " m along the ring axis from ring.centre): the ring would meet "
+                                 "nothing; give a height below the pole");
   doc.check_unknown_keys();
   return kc;
 }

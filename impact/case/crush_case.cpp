@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
 
+#include "fem/case/source_result.hpp"
 #include "fem/contact/tied_contact.hpp"
 #include "fem/elements/hex8_block.hpp"
 #include "fem/errors.hpp"
@@ -133,6 +135,9 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
   if (!std::filesystem::exists(im.source))
     m.fail("source", "no such file: " + im.source.string() +
                          " (run the transfer first: ncfsim run cases/hemisphere/transfer.toml)");
+  fem::require_result_of(m, "source", im.source, {"transfer"},
+                         "a crush needs a transfer's results (ncfsim run "
+                         "cases/hemisphere/transfer.toml makes one)");
   fem::io::StageFrame fr;
   try {
     fr = fem::io::read_last_frame(im.source);
@@ -434,6 +439,63 @@ void check_crack_band(const CaseReadContext& ctx) {
     }
 }
 
+namespace {
+
+// A crush that cannot crush, or whose filtered force would mean nothing, is bad input: a punch at
+// rest, a history too coarse for its CFC class, an end time before the punch reaches the part.
+void check_crush_process(const CaseReadContext& ctx, const TableReader& crush,
+                         const CrushSpec& cs) {
+  const auto& tool = ctx.model.tools[static_cast<std::size_t>(cs.punch)];
+  const auto tool_tables = ctx.root.tables("tool");
+  const double speed = fem::norm(tool.motion.velocity);
+  if (!(speed > 0)) {
+    const std::string msg = "the punch '" + tool.name +
+                            "' does not move (velocity [0, 0, 0]): a crush needs a punch "
+                            "velocity, e.g. [0, 0, -1.5] m/s";
+    for (const auto& tt : tool_tables)
+      if (tt.string("name", "") == tool.name) tt.fail("velocity", msg);
+    crush.fail("punch", msg);
+  }
+  // SAE J211: sample at least 10 x the channel frequency class (CFC 600: 6 kHz) before filtering.
+  const auto& time = ctx.model.time;
+  const double needed = 1.0 / (10.0 * cs.cfc);
+  if (time.history_interval > needed * (1 + 1e-9))
+    throw InputError(
+        ctx.file, "time.history_interval",
+        fmt::format("{:.4g} s samples the punch force at {:.4g} Hz: its CFC {:g} "
+                    "filter needs at least 10 x {:g} Hz (SAE J211), an interval of "
+                    "at most {:.4g} s",
+                    time.history_interval, 1.0 / time.history_interval, cs.cfc, cs.cfc, needed),
+        fmt::format("{:g}", time.history_interval), fmt::format("<= {:.4g}", needed));
+  // The punch must reach the part: its travel by the end time (half the C1 ramp at full speed)
+  // against the gap to the nearest of its contact nodes at the start.
+  const auto& mesh = ctx.model.mesh;
+  double gap_min = std::numeric_limits<double>::infinity();
+  const auto gap_of = [&](std::size_t i) {
+    double g = 0;
+    fem::V3 n;
+    const auto x = mesh.node(i);
+    if (tool.surface.gap_at(fem::V3{x[0], x[1], x[2]}, g, n)) gap_min = std::min(gap_min, g);
+  };
+  if (!tool.contact_nodes.empty())
+    for (const auto i : tool.contact_nodes) gap_of(static_cast<std::size_t>(i));
+  else
+    for (std::size_t i = 0; i < mesh.n_nodes(); ++i) gap_of(i);
+  const double travel =
+      speed * std::max(0.0, time.end_time - 0.5 * std::min(tool.motion.ramp_time, time.end_time));
+  if (std::isfinite(gap_min) && gap_min - tool.thickness > travel)
+    throw InputError(
+        ctx.file, "time.end_time",
+        fmt::format("the punch '{}' travels {:.4g} mm by the end time {:.4g} s but "
+                    "starts {:.4g} mm from the part: it would crush nothing; give "
+                    "an end time of at least {:.4g} s",
+                    tool.name, 1e3 * travel, time.end_time, 1e3 * (gap_min - tool.thickness),
+                    time.end_time + (gap_min - tool.thickness - travel) / speed),
+        fmt::format("{:g}", time.end_time));
+}
+
+}  // namespace
+
 CrushSpec read_crush(const CaseReadContext& ctx) {
   CrushSpec cs;
   const auto t = ctx.root.table("crush");
@@ -450,6 +512,7 @@ CrushSpec read_crush(const CaseReadContext& ctx) {
       fem::ToolMotion::Kind::Velocity)
     t->fail("punch", "the punch '" + punch + "' must move at a prescribed velocity");
   cs.cfc = t->number("cfc_class", 600.0, Range::closed(10, 10000));
+  check_crush_process(ctx, *t, cs);
   return cs;
 }
 

@@ -244,6 +244,40 @@ void report_failures(const std::vector<Variant>& variants, const std::vector<Out
   }
 }
 
+// Processes that parse but cannot run as meant (issue #45): each must be refused, exit 2.
+std::vector<Variant> process_variants(const fs::path& root) {
+  struct Change {
+    const char* file;
+    const char* key;
+    toml::node_type type;
+    double value;
+  };
+  const Change changes[] = {
+      {"cases/hemisphere/crush.toml", "tool[0].velocity", toml::node_type::array, 0.0},
+      {"cases/hemisphere/crush.toml", "time.history_interval", toml::node_type::floating_point,
+       1e-3},
+      {"cases/hemisphere/crush.toml", "time.end_time", toml::node_type::floating_point, 1e-5},
+      {"cases/hemisphere/fishnet.toml", "ring.height", toml::node_type::floating_point, 0.5},
+  };
+  std::vector<Variant> out;
+  int k = 0;
+  for (const auto& c : changes) {
+    toml::table t = toml::parse_file((root / c.file).string());
+    auto node = t.at_path(c.key);
+    if (c.type == toml::node_type::array && node.as_array())
+      *node.as_array() = toml::array{c.value, c.value, c.value};
+    else if (node.as_floating_point())
+      *node.as_floating_point() = c.value;
+    else
+      ADD_FAILURE() << c.file << ": no key " << c.key << " to change";
+    const fs::path f =
+        (root / c.file).parent_path() / ("process_variant_" + std::to_string(k++) + ".toml");
+    std::ofstream(f) << t << "\n";
+    out.push_back({f, std::string(c.file) + ": " + c.key + " = " + std::to_string(c.value)});
+  }
+  return out;
+}
+
 TEST(CliFuzz, MutatedCaseFilesEndWithExitZeroOrTwo) {
   const fs::path root = fresh_dir("case_fuzz");
   fs::create_directories(root);
@@ -270,6 +304,10 @@ TEST(CliFuzz, MutatedCaseFilesEndWithExitZeroOrTwo) {
   const std::vector<Variant> variants = make_variants(root, cases, large);
   ASSERT_GE(variants.size(), 2000u) << "from " << cases.size() << " case files";
   report_failures(variants, check_all(variants, false), by_code);
+  const std::vector<Variant> process = process_variants(root);
+  const auto refused = check_all(process, true);
+  for (std::size_t k = 0; k < process.size(); ++k)
+    EXPECT_EQ(refused[k].code, 2) << process[k].what << ": " << refused[k].log.substr(0, 400);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::size_t n_checked = cases.size() + variants.size();
   std::printf(

@@ -114,6 +114,13 @@ TEST(CliCrush, BadInputNamesTheKey) {
       {{"--set", "model.damage.fracture_energy.matrix_tension=0.0"},
        "model.damage.fracture_energy.matrix_tension"},
       {{"--set", "model.ties.interply.mode_i_energy=-1.0"}, "model.ties.interply.mode_i_energy"},
+      // The process (issue #45): a punch at rest, a force history too coarse for CFC 600 (SAE
+      // J211: at least 6 kHz), an end time before the punch reaches the part.
+      {{"--set", "tool[0].velocity=[0.0,0.0,0.0]"}, "tool[0].velocity"},
+      {{"--set", "time.history_interval=1e-3"}, "time.history_interval"},
+      {{"--set", "time.end_time=3e-5", "--set", "time.quasi_static_from=1e-5", "--set",
+        "time.frame_interval=1e-5"},
+       "time.end_time"},
   };
   for (const auto& b : bad) {
     const auto r = run_cli(f.crush("check", b.extra));

@@ -51,6 +51,11 @@ TEST(CliKinematicDrape, BadInputNamesTheKey) {
   r = run_cli({"run", case_file.string(), "-o", out.string(), "--set", "net.pole=[0.0,0.0,0.01]"});
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("net.pole"), std::string::npos) << r.output;
+  // A ring above the part meets nothing: bad input, and no maxima written (issue #45).
+  r = run_cli({"run", case_file.string(), "-o", out.string(), "--set", "ring.height=0.5"});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("ring.height"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
   r = run_cli({"check", case_file.string()});
   EXPECT_EQ(r.code, 0) << r.output;
   fs::remove_all(out);

@@ -207,6 +207,17 @@ TEST(CliTransfer, BadInputNamesTheKey) {
     EXPECT_EQ(r.code, 2) << r.output;
     EXPECT_NE(r.output.find(b.key), std::string::npos) << r.output;
   }
+  // A transfer's (or a crush's) results are not a drape's: the record beside them says so.
+  {
+    const fs::path t1 = f.dir / "t1";
+    auto ok = run_cli({"-q", "run", f.transfer_case.string(), "-o", t1.string()});
+    ASSERT_EQ(ok.code, 0) << ok.output;
+    const auto r = run_cli({"run", f.transfer_case.string(), "-o", (f.dir / "bad").string(),
+                            "--set", "source.results=" + (t1 / "results.h5").string()});
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("source.results"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("the result of a 'transfer' run"), std::string::npos) << r.output;
+  }
   // An unfinished drape run (its summary says so) is refused.
   const fs::path summary = f.dir / "drape" / "summary.json";
   auto s = nlohmann::json::parse(slurp(summary));

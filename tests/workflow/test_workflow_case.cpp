@@ -7,7 +7,9 @@
 //  * a stage that fails stops the workflow: the stages after it are not run and a rerun does not
 //    take the failed stage for done;
 //  * bad input (exit 2, naming it): a stage case that does not exist, a cycle between stages, an
-//    override for no stage, --force of no stage.
+//    override for no stage, --force of no stage, an input key the stage's case does not have;
+//  * a workflow folder copied elsewhere reruns nothing (issue #45: a stage's inputs hash takes
+//    its upstream's hash, not the upstream folder's path).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -108,6 +110,9 @@ TEST(CliWorkflow, BadInputNamesTheStageOrKey) {
       {run_args(out, {"--set", "nosuch.x=1"}), "neither names a stage"},
       {run_args(out, {"--force", "nosuch"}), "'nosuch' is not a stage"},
       {{"check", (kCases / "cycle.toml").string()}, "wait for each other"},
+      {{"check", (kCases / "input_key_missing.toml").string()}, "source.nothing"},
+      {{"run", (kCases / "input_key_missing.toml").string(), "-o", out.string()},
+       "is not a key of stage 'b'"},
   };
   for (const auto& b : bad) {
     const auto r = run_cli(b.args);
@@ -115,6 +120,31 @@ TEST(CliWorkflow, BadInputNamesTheStageOrKey) {
     EXPECT_NE(r.output.find(b.says), std::string::npos) << r.output;
   }
   EXPECT_FALSE(fs::exists(out / "summary.json")) << "bad input must not start the workflow";
+}
+
+// A stage's inputs hash takes its upstream stage's hash, not the path of the upstream's folder:
+// the workflow folder copied elsewhere (cp -a) reruns nothing.
+TEST(CliWorkflow, FolderCopiedElsewhereRerunsNothing) {
+  const fs::path out = fresh_dir("workflow_handoff"), moved = fresh_dir("workflow_handoff_moved");
+  const auto args = [&](const fs::path& o) {
+    return std::vector<std::string>{"-q", "run", (kCases / "handoff.toml").string(), "-o",
+                                    o.string()};
+  };
+  auto r = run_cli(args(out));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(stage_status(out),
+            (std::map<std::string, std::string>{{"a", "completed"}, {"b", "completed"}}));
+  fs::copy(out, moved, fs::copy_options::recursive);
+  r = run_cli(args(moved));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(stage_status(moved),
+            (std::map<std::string, std::string>{{"a", "skipped"}, {"b", "skipped"}}));
+  // b's hand-off still changes with a: a key of a reruns both.
+  r = run_cli({"-q", "run", (kCases / "handoff.toml").string(), "-o", moved.string(), "--set",
+               "a.time.end_time=0.014"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(stage_status(moved),
+            (std::map<std::string, std::string>{{"a", "completed"}, {"b", "completed"}}));
 }
 
 }  // namespace

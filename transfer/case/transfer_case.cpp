@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fem/case/fem_case.hpp"
+#include "fem/case/source_result.hpp"
 #include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
 
@@ -31,23 +32,13 @@ void read_resin(const TableReader& t, ResinData& r) {
   r.density = t.number("density", r.density, Range::positive());
 }
 
-// A drape result is usable once its run completed: its summary.json says so.
+// A drape result is usable once its run completed, and only a drape's: summary.json beside it
+// (the run's own record) says which stage wrote it and how it ended.
 void check_source(const TableReader& s, const std::filesystem::path& h5) {
   if (!std::filesystem::is_regular_file(h5))
     s.fail("results", "no such drape result: " + h5.string() + " (run the drape case first)");
-  const auto summary = h5.parent_path() / "summary.json";
-  if (!std::filesystem::is_regular_file(summary)) return;  // a result made elsewhere
-  nlohmann::json j;
-  try {
-    std::ifstream in(summary);
-    j = nlohmann::json::parse(in);
-  } catch (const std::exception&) {
-    s.fail("results", "the drape result's " + summary.string() + " cannot be read");
-  }
-  const std::string status = j.value("status", std::string("?"));
-  if (status != "completed")
-    s.fail("results", "the drape run in " + h5.parent_path().string() +
-                          " did not complete (status '" + status + "'): rerun or resume it first");
+  fem::require_result_of(s, "results", h5, {"engine"},
+                         "a transfer needs the results.h5 of a meso drape run");
 }
 
 }  // namespace

@@ -287,7 +287,7 @@ int compare_rings(const CompareOptions& opt) {
       sources[i].label += fmt::format(" ({})", n);
     }
 
-  const OutputFolder folder = OutputFolder::claim(opt.out_dir, opt.overwrite);
+  const OutputFolder folder = OutputFolder::claim(opt.out_dir, opt.overwrite, {}, "comparison");
   const fs::path& dir = opt.out_dir;
   auto log = make_run_logger(dir, opt.verbosity);
   log->info("ncfsim {} | compare | {} source{} -> {}", kVersion, sources.size(),

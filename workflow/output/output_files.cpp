@@ -5,8 +5,10 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 #include <stdexcept>
 
@@ -69,12 +71,26 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 
 HistoryWriter::HistoryWriter(const std::filesystem::path& file, std::vector<std::string> columns,
                              bool append)
-    : out_(file, append ? std::ios::app : std::ios::out), columns_(std::move(columns)) {
-  if (!out_) throw std::runtime_error("cannot write " + file.string());
+    : out_(file, append ? std::ios::app : std::ios::out),
+      columns_(std::move(columns)),
+      file_(file) {
+  if (!out_)
+    throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
   if (append) return;
-  for (std::size_t i = 0; i < columns_.size(); ++i) out_ << (i ? "," : "") << columns_[i];
-  out_ << '\n';
+  std::string header;
+  for (std::size_t i = 0; i < columns_.size(); ++i) header += (i ? "," : "") + columns_[i];
+  write_line(header + '\n');
+}
+
+// A row that does not reach the file (a full disk, a file-size limit) ends the run with the file
+// and the system's reason, rather than leaving a history that stops short without a word.
+void HistoryWriter::write_line(const std::string& line) {
+  errno = 0;
+  out_ << line;
   out_.flush();
+  if (!out_)
+    throw std::runtime_error("cannot write " + file_.string() + ": " +
+                             (errno ? std::strerror(errno) : "write failed"));
 }
 
 void HistoryWriter::write_row(const std::vector<double>& values) {
@@ -85,8 +101,7 @@ void HistoryWriter::write_row(const std::vector<double>& values) {
     line += fmt::format("{:.9g}", values[i]);
   }
   line += '\n';
-  out_ << line;
-  out_.flush();
+  write_line(line);
 }
 
 std::vector<double> CsvTable::column(const std::string& name) const {
@@ -133,8 +148,8 @@ void list_tree(const std::filesystem::path& dir, const std::vector<std::string>&
   for (auto it = fs::recursive_directory_iterator(dir, ec);
        !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
     const std::string rel = fs::relative(it->path(), dir).generic_string();
-    if (it.depth() == 0 &&
-        (rel == kManifest || std::find(keep.begin(), keep.end(), rel) != keep.end())) {
+    if (it.depth() == 0 && (rel == kManifest || rel == kFolderLockFile ||
+                            std::find(keep.begin(), keep.end(), rel) != keep.end())) {
       if (it->is_directory()) it.disable_recursion_pending();
       continue;
     }
@@ -151,7 +166,7 @@ bool listed(const std::vector<std::string>& sorted, const std::string& s) {
 }  // namespace
 
 OutputFolder OutputFolder::claim(const std::filesystem::path& dir, bool overwrite,
-                                 const std::vector<std::string>& keep) {
+                                 const std::vector<std::string>& keep, const std::string& what) {
   namespace fs = std::filesystem;
   OutputFolder o;
   o.dir_ = dir;
@@ -159,6 +174,14 @@ OutputFolder OutputFolder::claim(const std::filesystem::path& dir, bool overwrit
   if (fs::exists(dir) && !fs::is_directory(dir))
     throw InputError(dir.string(), "-o", "is a file, not a folder");
   fs::create_directories(dir);
+  o.lock_ = FolderLock::acquire(dir, what);
+  {  // held now: a summary still "running" belongs to a process that is gone
+    const nlohmann::json last = read_json_file(dir / "summary.json");
+    if (last.is_object() && last.value("status", "") == "running")
+      o.note_ = "the last run in this folder ended without a status (summary.json said running" +
+                (last.contains("cycles") ? ", at cycle " + last["cycles"].dump() : std::string()) +
+                "): it was killed or lost an MPI rank; its files are replaced";
+  }
   const fs::path manifest = dir / kManifest;
   if (fs::exists(manifest)) {
     const nlohmann::json m = read_json_file(manifest);
@@ -206,13 +229,17 @@ OutputFolder OutputFolder::claim(const std::filesystem::path& dir, bool overwrit
 OutputFolder OutputFolder::resume(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   const fs::path manifest = dir / kManifest;
-  const nlohmann::json m = read_json_file(manifest);
-  if (!m.is_object())
-    throw InputError(
+  const auto not_ours = [&] {
+    return InputError(
         dir.string(), "--resume",
         "is not an output folder of ncfsim (no readable " + std::string(kManifest) + ")");
+  };
+  if (!fs::is_regular_file(manifest)) throw not_ours();
   OutputFolder o;
   o.dir_ = dir;
+  o.lock_ = FolderLock::acquire(dir, "run (resumed)");  // before the manifest is read
+  const nlohmann::json m = read_json_file(manifest);
+  if (!m.is_object()) throw not_ours();
   o.before_files_ = m.value("before_files", std::vector<std::string>{});
   o.before_dirs_ = m.value("before_dirs", std::vector<std::string>{});
   std::sort(o.before_files_.begin(), o.before_files_.end());

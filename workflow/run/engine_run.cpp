@@ -254,6 +254,7 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
     r.summary["timers_s"]["loop_cycles"] = r.loop_cycles;
   }
   r.summary["kinetic_to_internal_from_s"] = r.ec.model.time.quasi_static_from;
+  r.summary["kinetic_to_internal_limit"] = r.ec.model.time.kinetic_to_internal_limit;
   r.summary["kinetic_to_internal_max"] = r.ke_ie_max;
   r.summary["kinetic_to_internal_end"] =
       s.energy().internal > 0 ? s.energy().kinetic / s.energy().internal : 0.0;
@@ -784,57 +785,25 @@ int run_engine_worker(EngineCase& ec, const RunOptions& options) {
   return kSuccess;
 }
 
-std::filesystem::path output_folder(const std::string& case_name, const RunOptions& o) {
-  return o.out_dir.empty() ? std::filesystem::path("results") / case_name : o.out_dir;
+namespace {
+
+// A run that ends by an exception after it said "running" (a file it cannot write, a disk that
+// fills, a numerical failure outside the loop) says so in summary.json: `failed` (or
+// `numerical_failure`) with the message as `error`. Best effort: the disk may refuse this too.
+void record_failure(Run& r, const std::exception& e) {
+  r.status = dynamic_cast<const NumericalError*>(&e) ? "numerical_failure" : "failed";
+  r.summary["status"] = r.status;
+  r.summary["error"] = e.what();
+  try {
+    r.log->error("run failed: {}", e.what());
+    r.write_summary();
+  } catch (...) {
+  }
 }
 
-int run_engine_case(EngineCase& ec, const RunOptions& options) {
-  Run r(ec, options);
-  if (options.resume && options.overwrite)
-    throw InputError(ec.file.string(), "--resume",
-                     "continues a run in its own folder: --overwrite does not go with it");
-  r.case_hash = checkpoint_case_hash(ec.file, options.overrides);
-  // --resume: the checkpoint is checked (version, case) before anything is written.
-  fem::CheckpointTree checkpoint;
-  if (options.resume) {
-    // The other ranks wait for the cycle to load: they get -1 when the checkpoint is refused.
-    std::int64_t cycle = -1;
-    try {
-      checkpoint = read_run_checkpoint(r.dir, ec, r.case_hash);
-      cycle = checkpoint.read_int("cycle");
-    } catch (...) {
-      if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
-      throw;
-    }
-    if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
-  }
-  const OutputFolder folder =
-      options.resume ? OutputFolder::resume(r.dir) : OutputFolder::claim(r.dir, options.overwrite);
-  r.log = make_run_logger(r.dir, options.verbosity, options.resume);
-  if (!options.resume) {
-    std::filesystem::copy_file(ec.file, r.dir / "case.toml",
-                               std::filesystem::copy_options::overwrite_existing);
-    write_figure_specs(r.dir, ec);
-  }
-  log_start(r);
-
-  const auto solver_ptr = make_solver(ec, r);
-  fem::ExplicitSolver& solver = *solver_ptr;
-  describe_model(solver, *r.log, r.summary);
-  MeasureList measures = make_run_measures(ec, solver);
-  for (const auto& m : measures)
-    for (const auto& line : m->setup_lines()) r.log->info("{}", line);
-  RunHistory history(r.dir / "history.csv", measures, !ec.samples.empty() || !ec.means.empty());
-  FrameOutput frames(r.dir, ec.output, solver, options.resume);
-  if (options.resume) {
-    load_checkpoint(r, checkpoint, solver, measures, history, frames);
-    r.log->info("resumed from {} at t = {:.6g} s, cycle {} (segment {})",
-                (r.dir / kCheckpointFile).string(), solver.time(), solver.cycle(), r.segments);
-  }
-
-  StopRequest::install();
-  r.summary["status"] = "running";
-  r.write_summary();
+// The run from its first cycle to its last file, once the folder is claimed and the model built.
+int finish_run(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHistory& history,
+               FrameOutput& frames, const OutputFolder& folder) {
   const double cpu0 = thread_cpu_seconds();
   const auto wall_loop0 = Clock::now();
   const std::int64_t cycle0 = solver.cycle();
@@ -897,6 +866,68 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   r.log->info("results in {} (status: {})", r.dir.string(), r.status);
   folder.finish();
   return exit_code;
+}
+
+}  // namespace
+
+std::filesystem::path output_folder(const std::string& case_name, const RunOptions& o) {
+  return o.out_dir.empty() ? std::filesystem::path("results") / case_name : o.out_dir;
+}
+
+int run_engine_case(EngineCase& ec, const RunOptions& options) {
+  Run r(ec, options);
+  if (options.resume && options.overwrite)
+    throw InputError(ec.file.string(), "--resume",
+                     "continues a run in its own folder: --overwrite does not go with it");
+  r.case_hash = checkpoint_case_hash(ec.file, options.overrides);
+  // --resume: the checkpoint is checked (version, case) before anything is written.
+  fem::CheckpointTree checkpoint;
+  if (options.resume) {
+    // The other ranks wait for the cycle to load: they get -1 when the checkpoint is refused.
+    std::int64_t cycle = -1;
+    try {
+      checkpoint = read_run_checkpoint(r.dir, ec, r.case_hash);
+      cycle = checkpoint.read_int("cycle");
+    } catch (...) {
+      if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
+      throw;
+    }
+    if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
+  }
+  const OutputFolder folder =
+      options.resume ? OutputFolder::resume(r.dir) : OutputFolder::claim(r.dir, options.overwrite);
+  r.log = make_run_logger(r.dir, options.verbosity, options.resume);
+  if (!options.resume) {
+    std::filesystem::copy_file(ec.file, r.dir / "case.toml",
+                               std::filesystem::copy_options::overwrite_existing);
+    write_figure_specs(r.dir, ec);
+  }
+  log_start(r);
+  if (!folder.note().empty()) r.log->warn("{}", folder.note());
+
+  const auto solver_ptr = make_solver(ec, r);
+  fem::ExplicitSolver& solver = *solver_ptr;
+  describe_model(solver, *r.log, r.summary);
+  MeasureList measures = make_run_measures(ec, solver);
+  for (const auto& m : measures)
+    for (const auto& line : m->setup_lines()) r.log->info("{}", line);
+  RunHistory history(r.dir / "history.csv", measures, !ec.samples.empty() || !ec.means.empty());
+  FrameOutput frames(r.dir, ec.output, solver, options.resume);
+  if (options.resume) {
+    load_checkpoint(r, checkpoint, solver, measures, history, frames);
+    r.log->info("resumed from {} at t = {:.6g} s, cycle {} (segment {})",
+                (r.dir / kCheckpointFile).string(), solver.time(), solver.cycle(), r.segments);
+  }
+
+  StopRequest::install();
+  r.summary["status"] = "running";
+  r.write_summary();
+  try {
+    return finish_run(r, solver, measures, history, frames, folder);
+  } catch (const std::exception& e) {
+    record_failure(r, e);
+    throw;
+  }
 }
 
 }  // namespace ncfsim::workflow

@@ -35,7 +35,8 @@ int run_kinematic_drape_stage(const StageCall& call) {
   const auto kc = drape::load_kinematic_drape_case(call.case_file, call.overrides);
   const auto t0 = std::chrono::steady_clock::now();
   const std::filesystem::path dir = output_folder(kc.name, call.options);
-  const OutputFolder folder = OutputFolder::claim(dir, call.options.overwrite);
+  const OutputFolder folder =
+      OutputFolder::claim(dir, call.options.overwrite, {}, "kinematic drape");
   auto log = make_run_logger(dir, call.options.verbosity);
   log->info("ncfsim {} | case '{}' ({}) | kinematic drape", kVersion, kc.name,
             call.case_file.string());

@@ -246,7 +246,7 @@ int run_transfer_stage(const StageCall& call) {
   const ImpregnatedModel m = build(tc, frame);
 
   const std::filesystem::path dir = output_folder(tc.name, call.options);
-  const OutputFolder folder = OutputFolder::claim(dir, call.options.overwrite);
+  const OutputFolder folder = OutputFolder::claim(dir, call.options.overwrite, {}, "transfer");
   auto log = make_run_logger(dir, call.options.verbosity);
   log->info("ncfsim {} | case '{}' ({}) | transfer", kVersion, tc.name, call.case_file.string());
   if (!tc.description.empty()) log->info("  {}", tc.description);

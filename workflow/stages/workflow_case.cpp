@@ -79,8 +79,18 @@ WorkflowCase load_workflow_case(const std::filesystem::path& file,
     s.case_file = std::filesystem::path(rel).is_absolute() ? std::filesystem::path(rel) : dir / rel;
     if (!std::filesystem::is_regular_file(s.case_file))
       t.fail("case", "the stage case " + s.case_file.string() + " does not exist");
-    if (const auto in = t.table("inputs"))
-      for (const auto& key : in->keys()) s.inputs.emplace_back(key, in->string(key));
+    if (const auto in = t.table("inputs")) {
+      // The key must be one the stage's case has: a key it does not have would take the path
+      // nowhere, and the stage would read whatever its case names instead.
+      const fem::CaseDocument sd = fem::CaseDocument::load(s.case_file, {});
+      for (const auto& key : in->keys()) {
+        if (!sd.root().at_path(key))
+          in->fail(key, "is not a key of stage '" + s.name + "''s case " + s.case_file.string() +
+                            " (an input hands the upstream results to a key the case has, e.g. "
+                            "\"source.results\" of a transfer or \"model.source\" of a crush)");
+        s.inputs.emplace_back(key, in->string(key));
+      }
+    }
     for (const auto& [key, up] : s.inputs) s.after.push_back(up);
     if (t.has("after"))
       for (const auto& up : t.strings("after")) s.after.push_back(up);

@@ -51,8 +51,14 @@ struct StagePlan {
 };
 
 // The stage's inputs and their hash; the upstream hashes are those of plans already made.
+// An input key is hashed as the name of its upstream stage, whose own hash stands for its
+// results: the results' path (in the workflow's folder) is not an input, so a workflow folder
+// moved or copied elsewhere reruns nothing.
 void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream_hash) {
-  const fem::CaseDocument doc = fem::CaseDocument::load(p.spec.case_file, p.overrides);
+  std::vector<std::string> hashed = p.spec.overrides;
+  for (const auto& [key, up] : p.spec.inputs)
+    hashed.push_back(key + "=" + json("results of stage " + up).dump());
+  const fem::CaseDocument doc = fem::CaseDocument::load(p.spec.case_file, hashed);
   Md5 md5;
   md5.add(kVersion);
   md5.add(hashed_case_text(doc.root()));
@@ -81,7 +87,7 @@ void hash_stage(StagePlan& p, const std::map<std::string, std::string>& upstream
   p.inputs = {{"hash", p.hash},
               {"ncfsim_version", kVersion},
               {"case_file", p.spec.case_file.lexically_normal().string()},
-              {"overrides", p.overrides},
+              {"overrides", hashed},
               {"files", files},
               {"upstream", up}};
 }
@@ -275,8 +281,10 @@ int run_workflow_stage(const StageCall& call) {
   if (const int rc = refuse_many_ranks()) return rc;
   std::vector<std::string> stage_dirs;
   for (const auto& p : plans) stage_dirs.push_back(p.spec.name);
-  const OutputFolder folder = OutputFolder::claim(out, call.options.overwrite, stage_dirs);
+  const OutputFolder folder =
+      OutputFolder::claim(out, call.options.overwrite, stage_dirs, "workflow");
   auto log = make_run_logger(out, call.options.verbosity);
+  if (!folder.note().empty()) log->warn("{}", folder.note());
   const auto t0 = std::chrono::steady_clock::now();
   const auto wall = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -568,13 +576,72 @@ void key_results_section(std::ostream& h, const json& stages,
     const std::string nm = e["name"].get<std::string>();
     const json& ss = sums.at(nm);
     if (!ss.is_object()) continue;
-    for (const auto& [k, label] : keys)
-      if (ss.contains(k))
-        h << "<tr><td>" << escape(nm) << "</td><td>" << label << "</td><td>"
-          << escape(ss[k].is_number() ? fmt::format("{:.4g}", ss[k].get<double>()) : ss[k].dump())
-          << "</td></tr>\n";
+    for (const auto& [k, label] : keys) {
+      if (!ss.contains(k)) continue;
+      std::string value =
+          escape(ss[k].is_number() ? fmt::format("{:.4g}", ss[k].get<double>()) : ss[k].dump());
+      // A check the stage failed shows as a warning, not as a plain number.
+      if (std::string(k) == "kinetic_to_internal_max" &&
+          ss.value("kinetic_to_internal_exceeded", false))
+        value = fmt::format(
+            "<span class=\"bad\">&#9888; {} &gt; its limit {:.3g} from {:.3g} s: not "
+            "quasi-static</span>",
+            value, ss.value("kinetic_to_internal_limit", 0.1),
+            ss.value("kinetic_to_internal_from_s", 0.0));
+      h << "<tr><td>" << escape(nm) << "</td><td>" << label << "</td><td>" << value
+        << "</td></tr>\n";
+    }
   }
   h << "</table>\n";
+}
+
+// A history plot whose every curve is zero (a tool that never touched, a fixed tool's
+// displacement) says nothing: its name, to be listed instead of drawn.
+std::vector<std::string> zero_plots(const fs::path& stage_dir) {
+  std::vector<std::string> zero;
+  const json specs = read_json_file(stage_dir / "figures.json");
+  if (!specs.is_object() || !specs.contains("plots")) return zero;
+  CsvTable history;
+  try {
+    history = read_csv(stage_dir / "history.csv");
+  } catch (const std::exception&) {
+    return zero;
+  }
+  for (const auto& p : specs["plots"]) {
+    if (p.value("source", "") != "history.csv" || !p.contains("y")) continue;
+    double largest = 0;
+    bool read = false;
+    for (const auto& col : p["y"]) {
+      try {
+        for (const double y : history.column(col.get<std::string>()))
+          if (std::isfinite(y)) largest = std::max(largest, std::abs(y)), read = true;
+      } catch (const std::exception&) {
+      }
+    }
+    if (read && largest <= 1e-6) zero.push_back(p.value("name", ""));
+  }
+  return zero;
+}
+
+// What a reader came for, first: the formed part by shear angle, the crush curve and the failed
+// modes (the ring comparison follows in its own section).
+void headline_section(std::ostream& h, const fs::path& dir, const json& stages) {
+  std::ostringstream f;
+  const auto add = [&](const std::string& stage, const std::string& png,
+                       const std::string& caption) {
+    if (!fs::exists(dir / stage / "figures" / png)) return;
+    f << "<figure><img src=\"" << escape(stage) << "/figures/" << escape(png) << "\" alt=\""
+      << escape(caption) << "\"><figcaption>" << escape(caption) << "</figcaption></figure>\n";
+  };
+  for (const auto& e : stages) {
+    const std::string nm = e["name"].get<std::string>(), kind = e.value("kind", "");
+    if (kind == "engine") add(nm, "formed_shear_iso.png", nm + ": the formed part by shear angle");
+    if (kind == "crush") {
+      add(nm, "crush_force.png", nm + ": punch force against stroke");
+      add(nm, "failed_mode.png", nm + ": failed mode per tow element");
+    }
+  }
+  if (!f.str().empty()) h << "<h2>Results</h2>\n" << f.str();
 }
 
 // Every stage's figures (formed part by shear angle, Vf map, failure modes, force curves,
@@ -589,11 +656,19 @@ void figures_section(std::ostream& h, const fs::path& dir, const json& stages) {
       if (f.path().extension() == ".png") pngs.push_back(f.path().filename().string());
     std::sort(pngs.begin(), pngs.end());
     if (pngs.empty()) continue;
+    const std::vector<std::string> zero = zero_plots(dir / nm);
     h << "<h2>" << escape(nm) << " (" << escape(e.value("kind", "")) << ")</h2>\n";
-    for (const auto& f : pngs)
+    std::string left_out;
+    for (const auto& f : pngs) {
+      if (std::find(zero.begin(), zero.end(), fs::path(f).stem().string()) != zero.end()) {
+        left_out += (left_out.empty() ? "" : ", ") + f;
+        continue;
+      }
       h << "<figure><img src=\"" << escape(nm) << "/figures/" << escape(f) << "\" alt=\""
         << escape(f) << "\"><figcaption>" << escape(nm) << ": " << escape(f)
         << "</figcaption></figure>\n";
+    }
+    if (!left_out.empty()) h << "<p>Not shown, zero throughout: " << escape(left_out) << "</p>\n";
   }
 }
 
@@ -638,9 +713,10 @@ void write_workflow_report(const fs::path& dir) {
         read_json_file(dir / e["folder"].get<std::string>() / "summary.json");
 
   const json& stages = s["stages"];
-  process_section(h, dir, stages, sums);
+  headline_section(h, dir, stages);
   drapes_section(h, dir, stages, sums);
   key_results_section(h, stages, sums);
+  process_section(h, dir, stages, sums);
   figures_section(h, dir, stages);
   warnings_section(h, dir, stages);
   h << "<p><a href=\"summary.json\">summary.json</a> &middot; <a href=\"log.txt\">log.txt</a></p>\n"
