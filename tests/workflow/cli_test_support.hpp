@@ -36,6 +36,27 @@ inline std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
+/// Open MPI keeps each job's session files under TMPDIR/ompi.HOST.UID, and processes started
+/// without a launcher at the same moment can share a name there (isolated singletons are all
+/// "jf.0/1"): one's clean-up then removes the directory the other is making, and that one fails
+/// or stalls in MPI_Init. Each child of a test gets a base of its own, removed when reaped.
+inline fs::path mpi_session_base(pid_t pid) {
+  return fs::temp_directory_path() / ("ncfsim_test_ompi_" + std::to_string(pid));
+}
+
+/// In a forked child, before exec: its own session base.
+inline void use_own_mpi_session_base() {
+  const std::string dir = mpi_session_base(getpid()).string();
+  ::mkdir(dir.c_str(), 0700);
+  ::setenv("OMPI_MCA_orte_tmpdir_base", dir.c_str(), 1);
+}
+
+/// After the child `pid` was reaped.
+inline void remove_mpi_session_base(pid_t pid) {
+  std::error_code ec;
+  fs::remove_all(mpi_session_base(pid), ec);
+}
+
 /// Starts ncfsim with args, stdout and stderr into `log`; returns the child's pid. With a
 /// launcher (e.g. {mpiexec, -n, 2}) the child is the launcher, given ncfsim and args.
 /// With `own_process_group` the child leads a process group of its own (its pid), so that a
@@ -49,6 +70,7 @@ inline pid_t spawn(const std::vector<std::string>& args, const fs::path& log,
     dup2(fd, 1);
     dup2(fd, 2);
     ::unsetenv("DISPLAY");
+    use_own_mpi_session_base();
     std::vector<std::string> all = launcher;
     all.push_back(kExe.string());
     all.insert(all.end(), args.begin(), args.end());
@@ -70,21 +92,50 @@ inline int exit_code(int status) {
 inline int wait_code(pid_t pid) {
   int status = 0;
   waitpid(pid, &status, 0);
+  remove_mpi_session_base(pid);
   return exit_code(status);
 }
 
 /// Exit code of the child, or -1 when it was still running after `seconds` (it is then sent
-/// SIGTERM and reaped).
+/// SIGTERM, SIGKILL 30 s later if it is still there, and reaped).
 inline int wait_code_within(pid_t pid, double seconds) {
-  for (double waited = 0; waited < seconds; waited += 0.05) {
-    int status = 0;
-    if (waitpid(pid, &status, WNOHANG) == pid) return exit_code(status);
-    usleep(50000);
-  }
+  auto reaped = [pid](double limit, int* code) {
+    for (double waited = 0; waited < limit; waited += 0.05) {
+      int status = 0;
+      if (waitpid(pid, &status, WNOHANG) == pid) {
+        remove_mpi_session_base(pid);
+        *code = exit_code(status);
+        return true;
+      }
+      usleep(50000);
+    }
+    return false;
+  };
+  int code = 0;
+  if (reaped(seconds, &code)) return code;
   kill(pid, SIGTERM);
-  wait_code(pid);
+  if (!reaped(30.0, &code)) {
+    kill(pid, SIGKILL);
+    wait_code(pid);
+  }
   return -1;
 }
+
+/// Kills (SIGKILL) and reaps, as the test ends however it ends, the children it names that are
+/// still running: a failed assertion never leaves a long run behind on the machine.
+struct ChildGuard {
+  std::vector<pid_t> pids;
+  ~ChildGuard() {
+    for (const pid_t p : pids) {
+      int status = 0;
+      if (waitpid(p, &status, WNOHANG) == 0) {  // ours and still running
+        kill(p, SIGKILL);
+        waitpid(p, &status, 0);
+      }
+      remove_mpi_session_base(p);
+    }
+  }
+};
 
 /// Runs ncfsim with args to the end (through `launcher` when one is given).
 inline Result run_cli(const std::vector<std::string>& args,

@@ -155,6 +155,7 @@ pid_t start_check(const fs::path& file, const fs::path& log) {
     ::unsetenv("DISPLAY");
     // No Open MPI daemon per check (a singleton forks one: ~0.2 s more per check here).
     ::setenv("OMPI_MCA_ess_singleton_isolated", "1", 1);
+    use_own_mpi_session_base();
     std::vector<std::string> args = {kExe.string(), "check", file.string()};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
@@ -206,6 +207,7 @@ std::vector<Outcome> check_all(const std::vector<Variant>& variants, bool keep) 
       } else {
         out[k].code = exit_code(status);
       }
+      remove_mpi_session_base(running[r].pid);
       const bool failed = out[k].code != 0 && out[k].code != 2;
       if (failed || keep) out[k].log = slurp(log_of(k));
       if (!failed) {

@@ -118,6 +118,7 @@ TEST(CliExitPaths, ClosedStdoutDoesNotKillTheRun) {
     dup2(fds[1], 1);
     dup2(fds[1], 2);
     ::unsetenv("DISPLAY");
+    use_own_mpi_session_base();
     std::vector<std::string> args = {
         kExe.string(), "run", kCube.string(), "-o", out.string(), "--progress-interval", "0.001"};
     std::vector<char*> argv;

@@ -52,7 +52,9 @@ bool wait_running(const fs::path& out, double seconds = 60) {
 // Exit code of pid, or -1 when it is still running (not reaped then).
 int poll_code(pid_t pid) {
   int status = 0;
-  return waitpid(pid, &status, WNOHANG) == pid ? exit_code(status) : -1;
+  if (waitpid(pid, &status, WNOHANG) != pid) return -1;
+  remove_mpi_session_base(pid);
+  return exit_code(status);
 }
 
 TEST(CliRunFolder, TwoRunsStartedTogetherIntoOneFolderOneIsRefused) {
@@ -60,6 +62,7 @@ TEST(CliRunFolder, TwoRunsStartedTogetherIntoOneFolderOneIsRefused) {
   const fs::path log_a = out.string() + ".a.log", log_b = out.string() + ".b.log";
   const pid_t a = spawn(long_run(out), log_a);
   const pid_t b = spawn(long_run(out, {"material[0].density=9000"}), log_b);
+  const ChildGuard guard{{a, b}};
   // The one refused ends at once; the other runs until it is stopped.
   int code_a = -1, code_b = -1;
   for (int i = 0; i < 1200 && code_a < 0 && code_b < 0; ++i) {
@@ -84,7 +87,7 @@ TEST(CliRunFolder, TwoRunsStartedTogetherIntoOneFolderOneIsRefused) {
     EXPECT_NE(r.output.find("is in use by process"), std::string::npos) << r.output;
   }
   kill(winner, SIGTERM);
-  EXPECT_EQ(wait_code(winner), 1) << slurp(a_won ? log_a : log_b);
+  EXPECT_EQ(wait_code_within(winner, 120), 1) << slurp(a_won ? log_a : log_b);
   // The winner's files are its own: its overrides, its status; the lock is gone with it.
   const auto s = summary(out);
   ASSERT_TRUE(s.is_object());
@@ -119,6 +122,7 @@ TEST(CliRunFolder, KilledRunIsFoundKilledByStatusAndTheNextRun) {
   const fs::path out = fresh_dir("folder_killed");
   const fs::path log = out.string() + ".log";
   const pid_t pid = spawn(long_run(out), log);
+  ChildGuard guard{{pid}};
   ASSERT_TRUE(wait_running(out)) << slurp(log);
   // While it runs, status says so and changes nothing.
   const auto live = run_cli({"status", out.string()});
@@ -129,6 +133,7 @@ TEST(CliRunFolder, KilledRunIsFoundKilledByStatusAndTheNextRun) {
   EXPECT_EQ(wait_code(pid), 128 + SIGKILL);
   // Again, killed: the next run warns that the last one ended without a status.
   const pid_t again = spawn(long_run(out), log);
+  guard.pids.push_back(again);
   ASSERT_TRUE(wait_running(out)) << slurp(log);
   kill(again, SIGKILL);
   wait_code(again);
@@ -140,6 +145,7 @@ TEST(CliRunFolder, KilledRunIsFoundKilledByStatusAndTheNextRun) {
       << "status had already set it right: " << next.output;
   // A summary left "running" by a killed run, not yet read by status: the next run says so.
   const pid_t third = spawn(long_run(out), log);
+  guard.pids.push_back(third);
   ASSERT_TRUE(wait_running(out)) << slurp(log);
   kill(third, SIGKILL);
   wait_code(third);
@@ -175,6 +181,7 @@ TEST(CliRunFolder, RunThatLostAnMpiRankIsFoundKilledByStatus) {
   // 320 hexahedra: enough to split over 2 ranks (a kernel chunk of 32 each at least).
   const pid_t pid =
       spawn(long_run(out, {"mesh.block[0].divisions=[80,2,2]"}), log, {kMpiexec, "-n", "2"});
+  const ChildGuard guard{{pid}};
   ASSERT_TRUE(wait_running(out)) << slurp(log);
   std::vector<pid_t> ranks;
   for (int i = 0; i < 100 && ranks.size() < 2; ++i) {
@@ -202,6 +209,7 @@ TEST(CliRunFolder, HistoryTheDiskRefusesEndsTheRunFailedNamingTheFile) {
     // no store (as the fuzz test's checks).
     ::setenv("OMPI_MCA_ess_singleton_isolated", "1", 1);
     ::setenv("PMIX_MCA_gds", "hash", 1);
+    use_own_mpi_session_base();
     rlimit lim{256 * 1024, 256 * 1024};
     setrlimit(RLIMIT_FSIZE, &lim);
     std::vector<std::string> args = {

@@ -79,7 +79,12 @@ std::unique_ptr<FolderLock> FolderLock::acquire(const std::filesystem::path& dir
           std::string("cannot be written (its lock file: ") + std::strerror(errno) + ")");
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
       const int err = errno;
-      const nlohmann::json h = nlohmann::json::parse(read_fd(fd), nullptr, false);
+      // The holder writes its note just after its lock is granted: a moment's wait names it.
+      nlohmann::json h = nlohmann::json::parse(read_fd(fd), nullptr, false);
+      for (int wait = 0; err == EWOULDBLOCK && !h.is_object() && wait < 100; ++wait) {
+        ::usleep(20'000);
+        h = nlohmann::json::parse(read_fd(fd), nullptr, false);
+      }
       ::close(fd);
       if (err == EWOULDBLOCK)
         throw InputError(dir.string(), key,
