@@ -33,7 +33,6 @@ struct FabricSpec {
   /// Tow (and ply) thickness from the areal weight: t = AW / (rho_f Vf w/p).
   double tow_thickness() const;
   /// Dry tow density rho_f Vf.
-  double tow_density() const { return fibre_density * tow_fibre_volume_fraction; }
   double gauge() const;
   double penetration_spacing() const;
 };

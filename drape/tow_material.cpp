@@ -56,11 +56,6 @@ fem::Voigt6x6 TowMaterial::stable_step_stiffness() const {
   return C;
 }
 
-double TowMaterial::p_wave_modulus() const {
-  const auto C = stable_step_stiffness();
-  return std::max({C[0], C[7], C[14]});
-}
-
 void TowMaterial::update_stress(const fem::MaterialBatch& b) const {
   const std::size_t s = b.stride, t = b.strain_stride;
   const double* __restrict de = b.strain_increment;

@@ -57,7 +57,6 @@ class TowMaterial final : public fem::SolidMaterial {
   TowMaterial(std::string name, const TowConstants& c);
   const std::string& name() const override { return name_; }
   double density() const override { return c_.density; }
-  double p_wave_modulus() const override;
   fem::Voigt6x6 elastic_stiffness() const override { return C_; }
   fem::Voigt6x6 bending_stiffness() const override { return C_bend_; }
   fem::Voigt6x6 stable_step_stiffness() const override;

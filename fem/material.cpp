@@ -70,10 +70,6 @@ ElasticOrthotropic::ElasticOrthotropic(std::string name, double density,
   if (!(density > 0)) throw std::invalid_argument("density must be > 0");
 }
 
-double ElasticOrthotropic::p_wave_modulus() const {
-  return std::max({C_[0], C_[7], C_[14]});
-}
-
 void ElasticOrthotropic::update_stress(const MaterialBatch& b) const {
   const std::size_t s = b.stride, t = b.strain_stride;
   const double* __restrict de = b.strain_increment;

@@ -31,8 +31,6 @@ class SolidMaterial {
   virtual ~SolidMaterial() = default;
   virtual const std::string& name() const = 0;
   virtual double density() const = 0;
-  /// Largest dilatational modulus (rho c^2) the law can reach: sets the stable time step.
-  virtual double p_wave_modulus() const = 0;
   /// Initial elastic stiffness in the material frame.
   virtual Voigt6x6 elastic_stiffness() const = 0;
   /// Stiffness of the linearly varying strain fields, i.e. of bending (the physical hourglass
@@ -54,7 +52,6 @@ class ElasticIsotropic final : public SolidMaterial {
   ElasticIsotropic(std::string name, double density, double youngs_modulus, double poisson_ratio);
   const std::string& name() const override { return name_; }
   double density() const override { return rho_; }
-  double p_wave_modulus() const override { return lambda_ + 2 * mu_; }
   Voigt6x6 elastic_stiffness() const override;
   void update_stress(const MaterialBatch& b) const override;
 
@@ -73,7 +70,6 @@ class ElasticOrthotropic final : public SolidMaterial {
   ElasticOrthotropic(std::string name, double density, const OrthotropicConstants& c);
   const std::string& name() const override { return name_; }
   double density() const override { return rho_; }
-  double p_wave_modulus() const override;
   Voigt6x6 elastic_stiffness() const override { return C_; }
   void update_stress(const MaterialBatch& b) const override;
 

@@ -71,8 +71,6 @@ NodalVector& NodalVector::operator=(NodalVector&& o) noexcept {
 
 void NodalVector::set(double value) { NCF_PETSC(VecSet(vec_, value)); }
 
-void NodalVector::copy_from(const NodalVector& other) { NCF_PETSC(VecCopy(other.vec_, vec_)); }
-
 NodalVector::View::View(Vec v, std::size_t n) : global_(v), n_(n) {
   NCF_PETSC(VecGhostGetLocalForm(global_, &local_));
   NCF_PETSC(VecGetArray(local_, &data_));

@@ -41,7 +41,6 @@ class NodalVector {
   Vec vec() const { return vec_; }
   std::size_t n_local_nodes() const { return n_local_; }
   void set(double value);
-  void copy_from(const NodalVector& other);
 
   /// Local array (owned + ghost entries), [3*n_local_nodes], valid until the view dies.
   class View {

@@ -196,6 +196,13 @@ bool RigidSurface::gap_at(const V3& p, double& gap, V3& normal) const {
   return false;
 }
 
+V3 tool_axis(const RigidTool& t) {
+  if (t.motion.kind == ToolMotion::Kind::Velocity && norm(t.motion.velocity) > 0)
+    return normalized(t.motion.velocity);
+  if (t.motion.kind == ToolMotion::Kind::Force) return t.motion.axis;
+  return t.surface.axis;
+}
+
 V3 tool_prescribed_velocity(const RigidTool& tool, double t) {
   if (tool.motion.kind != ToolMotion::Kind::Velocity) return {};
   return smooth_ramp(t, tool.motion.ramp_time) * tool.motion.velocity;

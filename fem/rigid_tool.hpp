@@ -122,6 +122,10 @@ inline double smooth_ramp(double t, double t_ramp) {
 /// Prescribed tool velocity at time t (Velocity kind).
 V3 tool_prescribed_velocity(const RigidTool& tool, double t);
 
+/// Axis a tool reports its scalar force and displacement along (a punch's stroke): its motion
+/// direction, the force's axis of a force-driven tool, else its surface's axis.
+V3 tool_axis(const RigidTool& tool);
+
 /// Contact forces of one tool at positions x, velocities v (last half step) and step dt;
 /// adds the forces on the nodes into f_contact [3*n_nodes] and updates the tool's state.
 /// node_travel: a running bound on how far any contact node has moved since the start (the

@@ -21,11 +21,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // A mode counts as failed once its damage is this close to 1 (the law clamps at exactly 1).
 constexpr double kFullDamage = 1.0 - 1e-9;
 
-fem::V3 punch_axis(const fem::RigidTool& t) {
-  const double n = norm(t.motion.velocity);
-  return n > 0 ? (1.0 / n) * t.motion.velocity : t.surface.axis;
-}
-
 }  // namespace
 
 CrushMeasure::CrushMeasure(const fem::ExplicitSolver& s, int punch, double cfc)
@@ -90,7 +85,7 @@ double CrushMeasure::tied_area(bool failed_only) const {
 
 void CrushMeasure::add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const {
   const auto& tool = s.model().tools[static_cast<std::size_t>(punch_)];
-  const fem::V3 ax = punch_axis(tool);
+  const fem::V3 ax = fem::tool_axis(tool);
   time_.push_back(s.time());
   stroke_.push_back(dot(tool.displacement, ax));
   force_.push_back(-dot(tool.force, ax));

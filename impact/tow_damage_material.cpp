@@ -43,8 +43,6 @@ TowDamageMaterial::TowDamageMaterial(std::string name, const TowDamageConstants&
   }
 }
 
-double TowDamageMaterial::p_wave_modulus() const { return std::max({C_[0], C_[7], C_[14]}); }
-
 double TowDamageMaterial::max_element_length(FailureMode m) const {
   return rf_length_[static_cast<std::size_t>(m)];
 }

@@ -78,7 +78,6 @@ class TowDamageMaterial final : public fem::SolidMaterial {
   TowDamageMaterial(std::string name, const TowDamageConstants& c);
   const std::string& name() const override { return name_; }
   double density() const override { return c_.density; }
-  double p_wave_modulus() const override;
   fem::Voigt6x6 elastic_stiffness() const override { return C_; }
   int n_history() const override { return kHistory; }
   int failure_history_row() const override { return kFailedRow; }

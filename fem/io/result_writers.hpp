@@ -162,8 +162,6 @@ class XdmfResultWriter {
   void close();
 
   std::size_t frames_written() const;
-  const std::filesystem::path& h5_path() const;
-  const std::filesystem::path& xdmf_path() const;
   /// The frames as results.xdmf lists them (what reopen takes back).
   std::vector<WrittenFrame> written_frames() const;
 
@@ -196,7 +194,6 @@ class VtuSeriesWriter {
   void close();
 
   std::size_t frames_written() const;
-  const std::filesystem::path& pvd_path() const;
   /// Path of the .vtu of frame `index` (0-based), whether or not it has been written yet.
   std::filesystem::path frame_path(std::size_t index) const;
   /// Takes over the frames 0..times.size()-1 an earlier writer wrote into this folder (a resumed

@@ -232,7 +232,6 @@ void VtuSeriesWriter::keep_frames(const std::vector<double>& times) {
 }
 
 std::size_t VtuSeriesWriter::frames_written() const { return impl_ ? impl_->entries.size() : 0; }
-const std::filesystem::path& VtuSeriesWriter::pvd_path() const { return impl_->pvd; }
 std::filesystem::path VtuSeriesWriter::frame_path(std::size_t index) const {
   return impl_->frames_dir / impl_->frame_name(index);
 }

@@ -604,7 +604,5 @@ XdmfResultWriter XdmfResultWriter::reopen(std::filesystem::path out_dir, ResultM
 }
 
 std::size_t XdmfResultWriter::frames_written() const { return impl_ ? impl_->frames.size() : 0; }
-const std::filesystem::path& XdmfResultWriter::h5_path() const { return impl_->h5; }
-const std::filesystem::path& XdmfResultWriter::xdmf_path() const { return impl_->xdmf; }
 
 }  // namespace ncfsim::fem::io

@@ -137,6 +137,35 @@ struct ChildGuard {
   }
 };
 
+/// Processes whose command line names ncfsim and `out` (a run's ranks and its launcher), less
+/// `except`.
+inline std::vector<pid_t> processes_naming(const fs::path& out, pid_t except = -1) {
+  std::vector<pid_t> pids;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t p = static_cast<pid_t>(std::stol(name));
+    if (p == except) continue;
+    std::ifstream in(e.path() / "cmdline", std::ios::binary);
+    std::string cmd((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (char& c : cmd)
+      if (c == '\0') c = ' ';
+    if (cmd.find(kExe.string()) != std::string::npos && cmd.find(out.string()) != std::string::npos)
+      pids.push_back(p);
+  }
+  return pids;
+}
+
+/// Waits (up to `seconds`) until no process names `out`: the ranks of a job whose launcher was
+/// killed outlive it for a moment, holding the folder. True when they are gone.
+inline bool wait_gone(const fs::path& out, double seconds = 60) {
+  for (double t = 0; t < seconds; t += 0.05) {
+    if (processes_naming(out).empty()) return true;
+    usleep(50000);
+  }
+  return false;
+}
+
 /// Runs ncfsim with args to the end (through `launcher` when one is given).
 inline Result run_cli(const std::vector<std::string>& args,
                       const std::vector<std::string>& launcher = {}) {

@@ -98,7 +98,8 @@ TEST(MpiRunsResume, KilledOnTwoRanksAndResumedGivesTheSameResults) {
   ASSERT_TRUE(wait_for_checkpoints(r, 2, 90)) << slurp(log);
   kill(-pid, SIGKILL);
   wait_code(pid);
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the ranks, reparented
+  // The ranks, reparented, end when they find their launcher gone; the folder is theirs until then.
+  ASSERT_TRUE(wait_gone(r)) << "the killed job's ranks are still running";
   ASSERT_TRUE(fs::exists(r / "checkpoint.h5"));
   EXPECT_FALSE(rank_files(r).empty());
   const auto res = run_cli(sled_run(r, {"--resume"}));

@@ -1,7 +1,7 @@
 // One run per output folder and a true status after every way a run ends (issue #45):
 //  * two runs started together into one folder: one is refused at once (exit 2, naming the folder
 //    and the process holding it), the other's files are its own; once it has ended the folder is
-//    free again;
+//    free again; a 2-rank run refused a folder in use ends on both ranks with exit 2;
 //  * render, report and export are refused while a run writes the folder;
 //  * a run killed (kill -9, on 1 rank, and one rank of 2) leaves summary.json "running": `ncfsim
 //    status` finds no process holding the folder, says killed and rewrites the summary so; the
@@ -159,19 +159,7 @@ TEST(CliRunFolder, KilledRunIsFoundKilledByStatusAndTheNextRun) {
 // The ranks of a 2-rank run: processes whose command line names the output folder, less the
 // launcher itself.
 std::vector<pid_t> ranks_of(const fs::path& out, pid_t launcher) {
-  std::vector<pid_t> pids;
-  for (const auto& e : fs::directory_iterator("/proc")) {
-    const std::string name = e.path().filename().string();
-    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    const pid_t p = static_cast<pid_t>(std::stol(name));
-    if (p == launcher) continue;
-    std::string cmd = slurp(e.path() / "cmdline");
-    for (char& c : cmd)
-      if (c == '\0') c = ' ';
-    if (cmd.find(kExe.string()) != std::string::npos && cmd.find(out.string()) != std::string::npos)
-      pids.push_back(p);
-  }
-  return pids;
+  return processes_naming(out, launcher);
 }
 
 TEST(CliRunFolder, RunThatLostAnMpiRankIsFoundKilledByStatus) {
@@ -195,6 +183,30 @@ TEST(CliRunFolder, RunThatLostAnMpiRankIsFoundKilledByStatus) {
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   expect_found_killed(out, true);
   fs::remove(log);
+}
+
+// A 2-rank run refused its folder: the root says why and ends, and the other rank, told so
+// before the model's first collective, ends with it (it used to wait there for ever).
+TEST(CliRunFolder, TwoRankRunIntoAFolderInUseIsRefusedAndEnds) {
+  if (!launcher_works()) GTEST_SKIP() << "no MPI launcher that starts here";
+  const fs::path out = fresh_dir("folder_refused_two_ranks");
+  const fs::path log = out.string() + ".log", log_two = out.string() + ".two.log";
+  const pid_t holder = spawn(long_run(out), log);
+  ChildGuard guard{{holder}};
+  ASSERT_TRUE(wait_running(out)) << slurp(log);
+  const pid_t two =
+      spawn(long_run(out, {"mesh.block[0].divisions=[80,2,2]"}), log_two, {kMpiexec, "-n", "2"});
+  guard.pids.push_back(two);
+  EXPECT_EQ(wait_code_within(two, 120), 2) << slurp(log_two);
+  EXPECT_NE(slurp(log_two).find("is in use by process " + std::to_string(holder)),
+            std::string::npos)
+      << slurp(log_two);
+  std::vector<pid_t> left = processes_naming(out, holder);
+  EXPECT_TRUE(left.empty()) << left.size() << " processes of the refused run are still there";
+  kill(holder, SIGTERM);
+  EXPECT_EQ(wait_code_within(holder, 120), 1) << slurp(log);
+  EXPECT_EQ(summary(out)["status"], "interrupted");
+  fs::remove(log), fs::remove(log_two);
 }
 
 TEST(CliRunFolder, HistoryTheDiskRefusesEndsTheRunFailedNamingTheFile) {

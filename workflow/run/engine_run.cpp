@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "fem/checkpoint.hpp"
@@ -713,13 +714,14 @@ void draw_figures_and_report(const Run& r) {
 
 int run_engine_worker(EngineCase& ec, const RunOptions& options) {
   RankCheckpoints ck{output_folder(ec, options), checkpoint_case_hash(ec.file, options.overrides)};
-  // --resume: the root checks checkpoint.h5 (and that every rank's file is there), then names
-  // its cycle, or -1 when it refuses the checkpoint (it reports why).
+  // The root's word before any collective of the model: -1 when it refused the run (the folder
+  // in use, a checkpoint refused, a file it could not write; it reports why), else the cycle of
+  // the checkpoint to load (--resume; it checked checkpoint.h5 and that every rank's file is
+  // there) or 0. Without it the other ranks would wait in the solver's first collective for a
+  // root that has ended.
   std::int64_t resume_cycle = -1;
-  if (options.resume) {
-    MPI_Bcast(&resume_cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
-    if (resume_cycle < 0) return kBadInput;
-  }
+  MPI_Bcast(&resume_cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
+  if (resume_cycle < 0) return kBadInput;
   std::unique_ptr<fem::ExplicitSolver> solver_ptr;
   try {
     solver_ptr = std::make_unique<fem::ExplicitSolver>(ec.model);
@@ -876,34 +878,37 @@ std::filesystem::path output_folder(const std::string& case_name, const RunOptio
 
 int run_engine_case(EngineCase& ec, const RunOptions& options) {
   Run r(ec, options);
-  if (options.resume && options.overwrite)
-    throw InputError(ec.file.string(), "--resume",
-                     "continues a run in its own folder: --overwrite does not go with it");
   r.case_hash = checkpoint_case_hash(ec.file, options.overrides);
-  // --resume: the checkpoint is checked (version, case) before anything is written.
+  // --resume: the checkpoint is checked (version, case) before anything is written. The other
+  // ranks wait for the root's word (run_engine_worker): the cycle to load (0 without --resume),
+  // or -1 when the root refuses the run here, whatever the reason.
   fem::CheckpointTree checkpoint;
-  if (options.resume) {
-    // The other ranks wait for the cycle to load: they get -1 when the checkpoint is refused.
-    std::int64_t cycle = -1;
-    try {
+  std::optional<OutputFolder> folder;
+  std::int64_t cycle = 0;
+  try {
+    if (options.resume && options.overwrite)
+      throw InputError(ec.file.string(), "--resume",
+                       "continues a run in its own folder: --overwrite does not go with it");
+    if (options.resume) {
       checkpoint = read_run_checkpoint(r.dir, ec, r.case_hash);
       cycle = checkpoint.read_int("cycle");
-    } catch (...) {
-      if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
-      throw;
     }
-    if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
+    folder.emplace(options.resume ? OutputFolder::resume(r.dir)
+                                  : OutputFolder::claim(r.dir, options.overwrite));
+    r.log = make_run_logger(r.dir, options.verbosity, options.resume);
+    if (!options.resume) {
+      std::filesystem::copy_file(ec.file, r.dir / "case.toml",
+                                 std::filesystem::copy_options::overwrite_existing);
+      write_figure_specs(r.dir, ec);
+    }
+  } catch (...) {
+    std::int64_t refused = -1;
+    if (fem::PetscSession::size() > 1) MPI_Bcast(&refused, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
+    throw;
   }
-  const OutputFolder folder =
-      options.resume ? OutputFolder::resume(r.dir) : OutputFolder::claim(r.dir, options.overwrite);
-  r.log = make_run_logger(r.dir, options.verbosity, options.resume);
-  if (!options.resume) {
-    std::filesystem::copy_file(ec.file, r.dir / "case.toml",
-                               std::filesystem::copy_options::overwrite_existing);
-    write_figure_specs(r.dir, ec);
-  }
+  if (fem::PetscSession::size() > 1) MPI_Bcast(&cycle, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD);
   log_start(r);
-  if (!folder.note().empty()) r.log->warn("{}", folder.note());
+  if (!folder->note().empty()) r.log->warn("{}", folder->note());
 
   const auto solver_ptr = make_solver(ec, r);
   fem::ExplicitSolver& solver = *solver_ptr;
@@ -923,7 +928,7 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   r.summary["status"] = "running";
   r.write_summary();
   try {
-    return finish_run(r, solver, measures, history, frames, folder);
+    return finish_run(r, solver, measures, history, frames, *folder);
   } catch (const std::exception& e) {
     record_failure(r, e);
     throw;

@@ -16,13 +16,6 @@ namespace ncfsim::workflow {
 
 using fem::V3;
 
-fem::V3 tool_axis(const fem::RigidTool& t) {
-  if (t.motion.kind == fem::ToolMotion::Kind::Velocity && norm(t.motion.velocity) > 0)
-    return normalized(t.motion.velocity);
-  if (t.motion.kind == fem::ToolMotion::Kind::Force) return t.motion.axis;
-  return t.surface.axis;
-}
-
 std::string sample_suffix(double at, const std::string& unit) {
   return fmt::format("_at_{:g}{}", at, unit);
 }

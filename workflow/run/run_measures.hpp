@@ -21,7 +21,4 @@ MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s
 /// The summary-sample key suffix of a sample point: "_at_<at><unit>" (e.g. "_at_10mm").
 std::string sample_suffix(double at, const std::string& unit);
 
-/// Axis a tool reports its scalar force and displacement along: its motion direction.
-fem::V3 tool_axis(const fem::RigidTool& t);
-
 }  // namespace ncfsim::workflow

@@ -123,21 +123,13 @@ const std::vector<Stage>& stages() {
   return registry;
 }
 
-const std::vector<std::string>& planned_stage_kinds() {
-  static const std::vector<std::string> planned{};
-  return planned;
-}
-
 const Stage& find_stage(const std::string& kind, const std::filesystem::path& file) {
   for (const auto& s : stages())
     if (s.kind == kind) return s;
   std::string allowed;
   for (const auto& s : stages()) allowed += (allowed.empty() ? "" : ", ") + s.kind;
-  std::string planned;
-  for (const auto& p : planned_stage_kinds()) planned += (planned.empty() ? "" : ", ") + p;
   throw InputError(file.string(), "case.kind",
-                   "'" + kind + "' is not a stage kind; allowed: " + allowed +
-                       (planned.empty() ? "" : " (planned, not in this build: " + planned + ")"));
+                   "'" + kind + "' is not a stage kind; allowed: " + allowed);
 }
 
 std::string case_kind(const std::filesystem::path& file,

@@ -32,8 +32,6 @@ struct Stage {
 
 /// The registered stages, in the order they are listed in messages.
 const std::vector<Stage>& stages();
-/// Kinds that are planned but not yet built (named in the error for an unknown kind).
-const std::vector<std::string>& planned_stage_kinds();
 
 /// The stage of `kind`; throws InputError(file, "case.kind") listing the allowed kinds.
 const Stage& find_stage(const std::string& kind, const std::filesystem::path& file = {});
