@@ -74,53 +74,46 @@ void require_output_folder(const std::filesystem::path& dir) {
     throw ncfsim::InputError(dir.string(), "", "not a folder (give the output folder of a run)");
 }
 
-}  // namespace
+// Each subcommand: its options (a struct), where they are declared on the command line
+// (add_*), and what it does (run_*). main() parses and dispatches.
 
-int main(int argc, char** argv) {
-  wf::StopRequest::install();  // before anything: a signal at any time ends the run cleanly
-  CLI::App app{
-      "ncfsim: meso-mechanical drape-to-failure simulation of stitched carbon fabric "
-      "(explicit finite elements)"};
-  app.set_version_flag("--version", std::string("ncfsim ") + wf::kVersion);
-  app.require_subcommand(1);
-  bool quiet = false, verbose = false;
-  app.add_flag("-q,--quiet", quiet,
-               "Only warnings and errors on the console (log.txt keeps everything)");
-  app.add_flag("-v,--verbose", verbose, "Debug messages on the console and in log.txt");
-
-  std::string case_file, out_dir;
-  std::vector<std::string> overrides;
+struct RunArgs {
+  CLI::App* cmd = nullptr;
+  std::string case_file, out_dir, inputs_hash;
+  std::vector<std::string> overrides, force_stages;
   int ranks = 1;
   double progress = 5.0;
+  bool overwrite = false, resume = false;
+};
+
+void add_run(CLI::App& app, RunArgs& a) {
   auto* run = app.add_subcommand("run",
                                  "Run a case: writes summary.json, history.csv, log.txt, "
                                  "results.h5/.xdmf and figures to the output folder");
-  run->add_option("case", case_file, "Case file (TOML)")->required();
-  run->add_option("-o,--output", out_dir, "Output folder (default results/<case name>)")
+  a.cmd = run;
+  run->add_option("case", a.case_file, "Case file (TOML)")->required();
+  run->add_option("-o,--output", a.out_dir, "Output folder (default results/<case name>)")
       ->check(CLI::Validator(
           [](const std::string& s) {
             return s.empty() ? std::string("an empty output folder") : std::string();
           },
           "FOLDER"));
-  run->add_option("--set", overrides,
+  run->add_option("--set", a.overrides,
                   "Override a case key: --set KEY=VALUE (repeatable), e.g. "
                   "--set mesh.resolution=coarse");
-  run->add_option("--np", ranks, "MPI ranks (default 1)")->check(CLI::Range(1, 1 << 20));
-  std::vector<std::string> force_stages;
-  bool overwrite = false;
-  run->add_flag("--overwrite", overwrite,
+  run->add_option("--np", a.ranks, "MPI ranks (default 1)")->check(CLI::Range(1, 1 << 20));
+  run->add_flag("--overwrite", a.overwrite,
                 "Write into an output folder that holds files ncfsim did not write (those of the "
                 "same names are replaced, nothing else is touched)");
-  run->add_option("--force", force_stages,
+  run->add_option("--force", a.force_stages,
                   "Workflow: rerun this stage although its inputs have not changed (repeatable)");
-  bool resume = false;
-  run->add_flag("--resume", resume,
+  run->add_flag("--resume", a.resume,
                 "Continue an interrupted run in its output folder from its checkpoint.h5 (the "
                 "same case and --set; time.max_cycles may differ)");
-  std::string inputs_hash;  // a workflow's engine stage started on several ranks: its inputs hash
-  run->add_option("--inputs-hash", inputs_hash, "(internal: set by a workflow for its stages)")
+  // A workflow's engine stage started on several ranks: its inputs hash.
+  run->add_option("--inputs-hash", a.inputs_hash, "(internal: set by a workflow for its stages)")
       ->group("");
-  run->add_option("--progress-interval", progress, "Seconds between progress lines (default 5)")
+  run->add_option("--progress-interval", a.progress, "Seconds between progress lines (default 5)")
       ->check(CLI::Validator(
           [](const std::string& s) {
             double v = 0;
@@ -134,40 +127,135 @@ int main(int argc, char** argv) {
                                              : std::string("must be a finite number > 0");
           },
           "SECONDS"));
+}
 
-  auto* check = app.add_subcommand("check",
-                                   "Validate a case without running it (exit 0, or 2 with the "
-                                   "file, key and allowed range)");
-  check->add_option("case", case_file, "Case file (TOML)")->required();
-  check->add_option("--set", overrides, "Override a case key: --set KEY=VALUE (repeatable)");
+// [case] kind -> its stage (workflow/stages/stage_registry.hpp).
+int run_run(const RunArgs& a, wf::Verbosity verbosity, int argc, char** argv) {
+  // A workflow is not relaunched: it runs its engine stages on --np ranks each.
+  if (a.ranks > 1 && !wf::started_by_mpi_launcher() &&
+      wf::case_kind(a.case_file, a.overrides) != "workflow")
+    return relaunch_with_mpiexec(a.ranks, argc, argv);
+  wf::StageCall call;
+  call.case_file = a.case_file;
+  call.overrides = a.overrides;
+  call.options.out_dir = a.out_dir;
+  call.options.verbosity = verbosity;
+  call.options.overrides = a.overrides;
+  call.options.ranks = a.ranks;
+  call.options.progress_interval_s = a.progress;
+  call.options.force_stages = a.force_stages;
+  call.options.overwrite = a.overwrite;
+  call.options.resume = a.resume;
+  call.options.inputs_hash = a.inputs_hash;
+  return wf::run_stage(call);
+}
 
-  std::string folder;
-  auto* render =
-      app.add_subcommand("render", "(Re)draw the figures of a finished run (off-screen)");
-  render->add_option("outdir", folder, "Output folder of a run")->required();
-  auto* status = app.add_subcommand(
+struct CheckArgs {
+  CLI::App* cmd = nullptr;
+  std::string case_file;
+  std::vector<std::string> overrides;
+};
+
+void add_check(CLI::App& app, CheckArgs& a) {
+  a.cmd = app.add_subcommand("check",
+                             "Validate a case without running it (exit 0, or 2 with the "
+                             "file, key and allowed range)");
+  a.cmd->add_option("case", a.case_file, "Case file (TOML)")->required();
+  a.cmd->add_option("--set", a.overrides, "Override a case key: --set KEY=VALUE (repeatable)");
+}
+
+// [case] kind -> its stage's check.
+int run_check(const CheckArgs& a) {
+  wf::StageCall call;
+  call.case_file = a.case_file;
+  call.overrides = a.overrides;
+  return wf::check_stage(call);
+}
+
+// render, status, report, export: the output folder of a finished (or running) run.
+struct FolderArgs {
+  CLI::App* render = nullptr;
+  CLI::App* status = nullptr;
+  CLI::App* report = nullptr;
+  CLI::App* exporter = nullptr;
+  std::string folder, deck_format;
+};
+
+void add_render_and_status(CLI::App& app, FolderArgs& a) {
+  a.render = app.add_subcommand("render", "(Re)draw the figures of a finished run (off-screen)");
+  a.render->add_option("outdir", a.folder, "Output folder of a run")->required();
+  a.status = app.add_subcommand(
       "status",
       "Say how a run or workflow in an output folder stands (running, completed, failed, ...); "
       "a summary that still says running with no process holding the folder becomes killed");
-  status->add_option("outdir", folder, "Output folder of a run or workflow")->required();
-  auto* report = app.add_subcommand("report", "Write report.html for a finished run");
-  report->add_option("outdir", folder, "Output folder of a run")->required();
-  std::string deck_format;
-  auto* exporter = app.add_subcommand(
+  a.status->add_option("outdir", a.folder, "Output folder of a run or workflow")->required();
+}
+
+void add_report_and_export(CLI::App& app, FolderArgs& a) {
+  a.report = app.add_subcommand("report", "Write report.html for a finished run");
+  a.report->add_option("outdir", a.folder, "Output folder of a run")->required();
+  a.exporter = app.add_subcommand(
       "export", "Write the impregnated model of a transfer run as an Abaqus or LS-DYNA deck");
-  exporter->add_option("outdir", folder, "Output folder of a transfer run")->required();
-  exporter->add_option("--format", deck_format, "abaqus | lsdyna")
+  a.exporter->add_option("outdir", a.folder, "Output folder of a transfer run")->required();
+  a.exporter->add_option("--format", a.deck_format, "abaqus | lsdyna")
       ->required()
       ->check(CLI::IsMember({"abaqus", "lsdyna"}));
+}
 
+int run_render(const std::string& folder, wf::Verbosity verbosity) {
+  require_output_folder(folder);
+  const auto lock = wf::FolderLock::acquire(folder, "render");  // not while a run writes
+  auto log = wf::make_run_logger({}, verbosity);
+  const auto pngs = wf::render_figures(folder, *log);
+  wf::OutputFolder::record(folder, pngs);
+  for (const auto& p : pngs) log->info("{}", p.string());
+  return pngs.empty() ? wf::kOtherError : wf::kSuccess;
+}
+
+int run_export(const std::string& folder, const std::string& deck_format) {
+  require_output_folder(folder);
+  const auto lock = wf::FolderLock::acquire(folder, "export");
+  const auto r = wf::export_impregnated(folder, deck_format);
+  wf::OutputFolder::record(folder, {r.file});
+  std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs, %zu stitch bars\n",
+              r.file.c_str(), r.nodes, r.elements, r.materials, r.tie_pairs, r.bars);
+  return wf::kSuccess;
+}
+
+int run_status(const std::string& folder) {
+  require_output_folder(folder);
+  for (const auto& f : wf::folder_status(folder))
+    std::printf("%s: %s%s\n", f.dir.c_str(), f.stage == "engine" ? "" : (f.stage + " ").c_str(),
+                f.line.c_str());
+  return wf::kSuccess;
+}
+
+int run_report(const std::string& folder) {
+  require_output_folder(folder);
+  const auto lock = wf::FolderLock::acquire(folder, "report");
+  const auto js = wf::read_json_file(std::filesystem::path(folder) / "summary.json");
+  if (js.is_object() && js.value("stage", "") == "workflow")
+    wf::write_workflow_report(folder);
+  else
+    wf::write_report(folder);
+  wf::OutputFolder::record(folder, {std::filesystem::path(folder) / "report.html"});
+  std::printf("%s\n", (std::filesystem::path(folder) / "report.html").c_str());
+  return wf::kSuccess;
+}
+
+struct StitchCalibrationArgs {
+  CLI::App* cmd = nullptr;
   wf::StitchCalibrationOptions sc;
   std::string shear = "positive";
-  auto* calibrate = app.add_subcommand("calibrate", "Calibrate model parameters from test data");
-  auto* cal_stitch = calibrate->add_subcommand(
+};
+
+void add_calibrate_stitch(CLI::App& calibrate, StitchCalibrationArgs& a) {
+  wf::StitchCalibrationOptions& sc = a.sc;
+  auto* cal_stitch = calibrate.add_subcommand(
       "stitch",
       "Stitch force-strain law from bias-extension force data (Eq. 2-6): positive shear "
       "calibrates the 'I' stitches, negative shear the 'Lambda' stitches");
-  calibrate->require_subcommand(1);
+  a.cmd = cal_stitch;
   cal_stitch->add_option("data", sc.data, "CSV with a header row")
       ->required()
       ->check(CLI::ExistingFile);
@@ -178,7 +266,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   cal_stitch->add_option("--force-scale", sc.force_scale, "Factor to N")
       ->check(CLI::PositiveNumber);
-  cal_stitch->add_option("--shear", shear, "positive | negative")
+  cal_stitch->add_option("--shear", a.shear, "positive | negative")
       ->check(CLI::IsMember({"positive", "negative"}));
   cal_stitch->add_option("--coupon-length", sc.coupon.length, "Free length H, m (default 0.25)")
       ->check(CLI::PositiveNumber);
@@ -198,12 +286,30 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 200));
   cal_stitch->add_option("--name", sc.law_name, "Name of the [[bar_law]] (default stitch)");
   cal_stitch->add_option("-o,--output", sc.out_dir, "Output folder (default stitch_calibration)");
+}
 
+int run_calibrate_stitch(StitchCalibrationArgs& a) {
+  a.sc.sign = a.shear == "negative" ? ncfsim::drape::ShearSign::Negative
+                                    : ncfsim::drape::ShearSign::Positive;
+  wf::calibrate_stitch(a.sc);
+  std::printf(
+      "%s: stitch_law.csv, stitch_law.toml, figures/stitch_law.png, figures/stitch_fit.png\n",
+      a.sc.out_dir.c_str());
+  return wf::kSuccess;
+}
+
+struct TowBendingArgs {
+  CLI::App* cmd = nullptr;
   wf::TowBendingCalibration tb;
-  auto* cal_bend = calibrate->add_subcommand(
+};
+
+void add_calibrate_tow_bending(CLI::App& calibrate, TowBendingArgs& a) {
+  wf::TowBendingCalibration& tb = a.tb;
+  auto* cal_bend = calibrate.add_subcommand(
       "tow-bending",
       "Tow fibre modulus E11f that gives a target ASTM D1388 bending length in the "
       "virtual cantilever test (the case needs an [[output.bending_length]] probe)");
+  a.cmd = cal_bend;
   cal_bend->add_option("case", tb.case_file, "Cantilever-bending case (TOML)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -219,13 +325,33 @@ int main(int argc, char** argv) {
   cal_bend->add_option("--set", tb.overrides, "Override a case key (repeatable)");
   cal_bend->add_option("-o,--output", tb.out_dir,
                        "Output folder (default tow_bending_calibration)");
+}
 
+int run_calibrate_tow_bending(const TowBendingArgs& a) {
+  ncfsim::fem::PetscSession petsc;
+  if (const int code = wf::refuse_many_ranks()) return code;
+  const auto r = wf::calibrate_tow_bending(a.tb);
+  std::printf(
+      "E11f = %.6g Pa gives a bending length of %.6g m (target %.6g m) after %d runs%s; see "
+      "%s\n",
+      r.E11f, r.bending_length, a.tb.target_bending_length, r.runs,
+      r.converged ? "" : " (NOT converged)", (a.tb.out_dir / "calibration.json").c_str());
+  return r.converged ? wf::kSuccess : wf::kNumericalFailure;
+}
+
+struct MacroCalibrationArgs {
+  CLI::App* cmd = nullptr;
   wf::MacroCalibrationOptions mc;
-  std::vector<double> mc_angles;
-  auto* cal_macro = calibrate->add_subcommand(
+  std::vector<double> angles;
+};
+
+void add_calibrate_macro(CLI::App& calibrate, MacroCalibrationArgs& a) {
+  wf::MacroCalibrationOptions& mc = a.mc;
+  auto* cal_macro = calibrate.add_subcommand(
       "macro",
       "Macro fabric membrane law ([[membrane_law]] type fabric) from the meso picture-frame "
       "runs: normalised shear force vs shear angle per sign, monotone, as a TOML block");
+  a.cmd = cal_macro;
   cal_macro->add_option("--positive", mc.positive, "Meso picture-frame run folder, positive shear")
       ->required();
   cal_macro->add_option("--negative", mc.negative, "Meso picture-frame run folder, negative shear")
@@ -248,7 +374,7 @@ int main(int argc, char** argv) {
   cal_macro->add_option("--max-angle", mc.max_angle_deg,
                         "Last angle of the curve, deg (default: as far as the runs reach)");
   cal_macro->add_option("--areal-density", mc.areal_density, "kg/m^2 (default 0.482)");
-  cal_macro->add_option("--fibre-angles", mc_angles, "From the wale, deg (default 45,-45)")
+  cal_macro->add_option("--fibre-angles", a.angles, "From the wale, deg (default 45,-45)")
       ->expected(2)
       ->delimiter(',');
   cal_macro->add_option("--fibre-tension-stiffness", mc.fibre_tension_stiffness,
@@ -264,13 +390,32 @@ int main(int argc, char** argv) {
                         "Also write the meso curves on the grid (fitted and clipped) to this CSV");
   cal_macro->add_option("-o,--output", mc.output,
                         "The TOML file written (default macro_membrane_law.toml)");
+}
 
+int run_calibrate_macro(MacroCalibrationArgs& a) {
+  wf::MacroCalibrationOptions& mc = a.mc;
+  if (!a.angles.empty()) mc.fibre_angles_deg = {a.angles[0], a.angles[1]};
+  const auto r = wf::calibrate_macro(mc);
+  for (const auto& n : r.notes) std::printf("%s\n", n.c_str());
+  std::printf("%s: [[membrane_law]] \"%s\" (%zu + %zu curve points)\n", mc.output.c_str(),
+              mc.name.c_str(), r.positive.curve.angle_deg.size(),
+              mc.symmetric ? std::size_t{0} : r.negative.curve.angle_deg.size());
+  return wf::kSuccess;
+}
+
+struct CompareArgs {
+  CLI::App* cmd = nullptr;
   wf::CompareOptions cmp;
   std::vector<double> ring_centre, ring_axis, ring_zero;
+};
+
+void add_compare(CLI::App& app, CompareArgs& a) {
+  wf::CompareOptions& cmp = a.cmp;
   auto* compare = app.add_subcommand(
       "compare",
       "Shear rings (the Fig. 18 measure) of drape runs and imported macro results side by side: "
       "quadrant maxima, RMS and largest differences, one plot");
+  a.cmd = compare;
   compare
       ->add_option("sources", cmp.sources,
                    "Run folders (meso drape, kinematic_drape, macro drape, workflow) and macro "
@@ -287,18 +432,61 @@ int main(int argc, char** argv) {
                       "Imported files: factor from their length unit to m (default 1; 1e-3: mm)");
   compare->add_option("--ring-height", cmp.import.ring.height,
                       "Ring height above the reference plane, m (default 0.04)");
-  compare->add_option("--ring-centre", ring_centre, "Point of the axis in the plane: x,y,z (m)")
+  compare->add_option("--ring-centre", a.ring_centre, "Point of the axis in the plane: x,y,z (m)")
       ->expected(3)
       ->delimiter(',');
-  compare->add_option("--ring-axis", ring_axis, "Ring axis: x,y,z (default 0,0,1)")
+  compare->add_option("--ring-axis", a.ring_axis, "Ring axis: x,y,z (default 0,0,1)")
       ->expected(3)
       ->delimiter(',');
-  compare->add_option("--ring-zero-direction", ring_zero, "Azimuth 0, the wale: x,y,z (1,0,0)")
+  compare->add_option("--ring-zero-direction", a.ring_zero, "Azimuth 0, the wale: x,y,z (1,0,0)")
       ->expected(3)
       ->delimiter(',');
   compare->add_option("--ring-step", cmp.import.ring.step_deg, "Azimuth step, deg (default 1)");
   compare->add_flag("--overwrite", cmp.overwrite,
                     "Write into a folder that holds files ncfsim did not write");
+}
+
+int run_compare(CompareArgs& a, wf::Verbosity verbosity) {
+  wf::CompareOptions& cmp = a.cmp;
+  cmp.verbosity = verbosity;
+  if (!a.ring_centre.empty()) cmp.import.ring.centre = ncfsim::fem::V3::at(a.ring_centre.data());
+  if (!a.ring_axis.empty()) cmp.import.ring.axis = ncfsim::fem::V3::at(a.ring_axis.data());
+  if (!a.ring_zero.empty())
+    cmp.import.ring.zero_direction = ncfsim::fem::V3::at(a.ring_zero.data());
+  return wf::compare_rings(cmp);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  wf::StopRequest::install();  // before anything: a signal at any time ends the run cleanly
+  CLI::App app{
+      "ncfsim: meso-mechanical drape-to-failure simulation of stitched carbon fabric "
+      "(explicit finite elements)"};
+  app.set_version_flag("--version", std::string("ncfsim ") + wf::kVersion);
+  app.require_subcommand(1);
+  bool quiet = false, verbose = false;
+  app.add_flag("-q,--quiet", quiet,
+               "Only warnings and errors on the console (log.txt keeps everything)");
+  app.add_flag("-v,--verbose", verbose, "Debug messages on the console and in log.txt");
+
+  RunArgs run;
+  CheckArgs check;
+  FolderArgs folder;
+  StitchCalibrationArgs stitch;
+  TowBendingArgs bending;
+  MacroCalibrationArgs macro;
+  CompareArgs compare;
+  add_run(app, run);
+  add_check(app, check);
+  add_render_and_status(app, folder);
+  add_report_and_export(app, folder);
+  auto* calibrate = app.add_subcommand("calibrate", "Calibrate model parameters from test data");
+  add_calibrate_stitch(*calibrate, stitch);
+  calibrate->require_subcommand(1);
+  add_calibrate_tow_bending(*calibrate, bending);
+  add_calibrate_macro(*calibrate, macro);
+  add_compare(app, compare);
 
   try {
     app.parse(argc, argv);
@@ -309,107 +497,17 @@ int main(int argc, char** argv) {
   const wf::Verbosity verbosity = quiet     ? wf::Verbosity::Quiet
                                   : verbose ? wf::Verbosity::Verbose
                                             : wf::Verbosity::Normal;
-
   try {
-    if (*check) {  // [case] kind -> its stage's check
-      wf::StageCall call;
-      call.case_file = case_file;
-      call.overrides = overrides;
-      return wf::check_stage(call);
-    }
-    if (*run) {  // [case] kind -> its stage (workflow/stages/stage_registry.hpp)
-      // A workflow is not relaunched: it runs its engine stages on --np ranks each.
-      if (ranks > 1 && !wf::started_by_mpi_launcher() &&
-          wf::case_kind(case_file, overrides) != "workflow")
-        return relaunch_with_mpiexec(ranks, argc, argv);
-      wf::StageCall call;
-      call.case_file = case_file;
-      call.overrides = overrides;
-      call.options.out_dir = out_dir;
-      call.options.verbosity = verbosity;
-      call.options.overrides = overrides;
-      call.options.ranks = ranks;
-      call.options.progress_interval_s = progress;
-      call.options.force_stages = force_stages;
-      call.options.overwrite = overwrite;
-      call.options.resume = resume;
-      call.options.inputs_hash = inputs_hash;
-      return wf::run_stage(call);
-    }
-    if (*compare) {
-      cmp.verbosity = verbosity;
-      if (!ring_centre.empty()) cmp.import.ring.centre = ncfsim::fem::V3::at(ring_centre.data());
-      if (!ring_axis.empty()) cmp.import.ring.axis = ncfsim::fem::V3::at(ring_axis.data());
-      if (!ring_zero.empty())
-        cmp.import.ring.zero_direction = ncfsim::fem::V3::at(ring_zero.data());
-      return wf::compare_rings(cmp);
-    }
-    if (*cal_stitch) {
-      sc.sign = shear == "negative" ? ncfsim::drape::ShearSign::Negative
-                                    : ncfsim::drape::ShearSign::Positive;
-      wf::calibrate_stitch(sc);
-      std::printf(
-          "%s: stitch_law.csv, stitch_law.toml, figures/stitch_law.png, figures/stitch_fit.png\n",
-          sc.out_dir.c_str());
-      return wf::kSuccess;
-    }
-    if (*cal_macro) {
-      if (!mc_angles.empty()) mc.fibre_angles_deg = {mc_angles[0], mc_angles[1]};
-      const auto r = wf::calibrate_macro(mc);
-      for (const auto& n : r.notes) std::printf("%s\n", n.c_str());
-      std::printf("%s: [[membrane_law]] \"%s\" (%zu + %zu curve points)\n", mc.output.c_str(),
-                  mc.name.c_str(), r.positive.curve.angle_deg.size(),
-                  mc.symmetric ? std::size_t{0} : r.negative.curve.angle_deg.size());
-      return wf::kSuccess;
-    }
-    if (*cal_bend) {
-      ncfsim::fem::PetscSession petsc;
-      if (const int code = wf::refuse_many_ranks()) return code;
-      const auto r = wf::calibrate_tow_bending(tb);
-      std::printf(
-          "E11f = %.6g Pa gives a bending length of %.6g m (target %.6g m) after %d runs%s; see "
-          "%s\n",
-          r.E11f, r.bending_length, tb.target_bending_length, r.runs,
-          r.converged ? "" : " (NOT converged)", (tb.out_dir / "calibration.json").c_str());
-      return r.converged ? wf::kSuccess : wf::kNumericalFailure;
-    }
-    if (*render) {
-      require_output_folder(folder);
-      const auto lock = wf::FolderLock::acquire(folder, "render");  // not while a run writes
-      auto log = wf::make_run_logger({}, verbosity);
-      const auto pngs = wf::render_figures(folder, *log);
-      wf::OutputFolder::record(folder, pngs);
-      for (const auto& p : pngs) log->info("{}", p.string());
-      return pngs.empty() ? wf::kOtherError : wf::kSuccess;
-    }
-    if (*exporter) {
-      require_output_folder(folder);
-      const auto lock = wf::FolderLock::acquire(folder, "export");
-      const auto r = wf::export_impregnated(folder, deck_format);
-      wf::OutputFolder::record(folder, {r.file});
-      std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie pairs, %zu stitch bars\n",
-                  r.file.c_str(), r.nodes, r.elements, r.materials, r.tie_pairs, r.bars);
-      return wf::kSuccess;
-    }
-    if (*status) {
-      require_output_folder(folder);
-      for (const auto& f : wf::folder_status(folder))
-        std::printf("%s: %s%s\n", f.dir.c_str(), f.stage == "engine" ? "" : (f.stage + " ").c_str(),
-                    f.line.c_str());
-      return wf::kSuccess;
-    }
-    if (*report) {
-      require_output_folder(folder);
-      const auto lock = wf::FolderLock::acquire(folder, "report");
-      const auto js = wf::read_json_file(std::filesystem::path(folder) / "summary.json");
-      if (js.is_object() && js.value("stage", "") == "workflow")
-        wf::write_workflow_report(folder);
-      else
-        wf::write_report(folder);
-      wf::OutputFolder::record(folder, {std::filesystem::path(folder) / "report.html"});
-      std::printf("%s\n", (std::filesystem::path(folder) / "report.html").c_str());
-      return wf::kSuccess;
-    }
+    if (*check.cmd) return run_check(check);
+    if (*run.cmd) return run_run(run, verbosity, argc, argv);
+    if (*compare.cmd) return run_compare(compare, verbosity);
+    if (*stitch.cmd) return run_calibrate_stitch(stitch);
+    if (*macro.cmd) return run_calibrate_macro(macro);
+    if (*bending.cmd) return run_calibrate_tow_bending(bending);
+    if (*folder.render) return run_render(folder.folder, verbosity);
+    if (*folder.exporter) return run_export(folder.folder, folder.deck_format);
+    if (*folder.status) return run_status(folder.folder);
+    if (*folder.report) return run_report(folder.folder);
   } catch (const ncfsim::InputError& e) {
     return bad_input(e);
   } catch (const ncfsim::NumericalError& e) {

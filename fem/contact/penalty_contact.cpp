@@ -175,7 +175,7 @@ void PenaltyContact::block_frames(const double* x, const std::int32_t* seg, std:
 void PenaltyContact::compute_frames(const double* x, std::size_t blk) {
   const std::size_t n_seg = surf_.n_segments(), s0 = blk * kFrameLanes;
   const std::size_t n_lanes = std::min<std::size_t>(kFrameLanes, n_seg - s0);
-  std::int32_t seg[kFrameLanes];
+  std::int32_t seg[kFrameLanes] = {};
   for (std::size_t l = 0; l < n_lanes; ++l) seg[l] = static_cast<std::int32_t>(s0 + l);
   SegmentFrameBlock fb;
   block_frames(x, seg, n_lanes, fb);
@@ -293,6 +293,8 @@ void PenaltyContact::restrict_to_rank(const std::uint8_t* owned, const std::uint
   resort_ = true;
 }
 
+// The broad phase, long by design (issue #44): its passes share the bucket arrays and the
+// candidates' order, which the narrow phase's prefetching relies on.
 void PenaltyContact::sort_segments(const double* x) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t ng = n_groups_, n_node = surf_.n_nodes(), n_act = active_seg_.size();
@@ -465,6 +467,8 @@ namespace {
 constexpr double kStick = 1e-4;
 }
 
+// A kernel, long by design (issue #44): the narrow phase and the force pass share the hit
+// records and the batch while they are in cache.
 void PenaltyContact::add_forces(const double* x, const double* v, const double*, double dt,
                                 double* f) {
   const std::size_t n_node = surf_.n_nodes(), ng = n_groups_;

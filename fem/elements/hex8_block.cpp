@@ -497,6 +497,8 @@ inline void sum_outer(const V3v* u, const V3v* w, VD (&M)[9]) {
 
 }  // namespace
 
+// A kernel, long by design (issue #44): one pass over a batch of SIMD lanes with the gradients,
+// strains, stresses and forces in registers; cut into functions it would spill them.
 void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double dt, double* f,
                           ElementEnergyIncrement& energy, StableStep& step, const double* x_ref) {
   const std::size_t n = b.n;

@@ -126,9 +126,10 @@ void register_impact_case_types(fem::CaseTypeRegistry& registry) {
 
 bool has_impregnated_model(const CaseReadContext& ctx) { return ctx.root.has("model"); }
 
-ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
-  const TableReader m = ctx.root.required_table("model");
-  ImpregnatedImport im;
+namespace {
+
+// The transfer's results.h5 named by model.source (its own record says so), its last frame.
+fem::io::StageFrame read_source_frame(const TableReader& m, ImpregnatedImport& im) {
   im.source = m.string("source");
   if (im.source.is_relative())
     im.source = std::filesystem::absolute(m.file().parent_path() / im.source);
@@ -144,9 +145,37 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
   } catch (const std::exception& e) {
     m.fail("source", e.what());
   }
+  if (fr.mesh.n_hex() == 0) m.fail("source", im.source.string() + " holds no hexahedra");
+  return fr;
+}
+
+// The mesh node of a result point, made on first use: the nodes in first-use order (the
+// transfer's order is the drape's locality order: kept, no renumbering).
+struct NodeImport {
+  fem::Mesh& mesh;
+  const fem::io::ResultMesh& rm;
+  std::vector<std::int32_t> node_of;
+  NodeImport(fem::Mesh& m, const fem::io::ResultMesh& r)
+      : mesh(m), rm(r), node_of(r.n_points(), -1) {}
+  std::int32_t operator()(std::int64_t point) {
+    const auto p = static_cast<std::size_t>(point);
+    if (node_of[p] < 0) {
+      node_of[p] = static_cast<std::int32_t>(mesh.n_nodes());
+      for (std::size_t c = 0; c < 3; ++c) mesh.coords.push_back(rm.points[3 * p + c]);
+      mesh.node_user_id.push_back(rm.node_user_id.empty() ? static_cast<std::int64_t>(p + 1)
+                                                          : rm.node_user_id[p]);
+    }
+    return node_of[p];
+  }
+};
+
+// The tow hexahedra with their material frames, and their Vf classes (a class's constants are
+// those of its first element).
+void import_hexahedra(const TableReader& m, const fem::io::StageFrame& fr, NodeImport& node,
+                      ImpregnatedImport& im) {
   const auto& rm = fr.mesh;
   const std::size_t nh = rm.n_hex();
-  if (nh == 0) m.fail("source", im.source.string() + " holds no hexahedra");
+  fem::Mesh& mesh = node.mesh;
   // The transfer's own fields; their absence means another kind of result.
   const auto& f1 = cell_field(fr, "fibre_direction", 3, m);
   const auto& f2 = cell_field(fr, "material_axis_2", 3, m);
@@ -159,21 +188,6 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
                                      scalar("G12_Pa"), scalar("G13_Pa"), scalar("G23_Pa")};
   const std::vector<double>* X[6] = {scalar("Xt_Pa"), scalar("Xc_Pa"),  scalar("Yt_Pa"),
                                      scalar("Yc_Pa"), scalar("S12_Pa"), scalar("S23_Pa")};
-
-  // Nodes used by the hexahedra, in first-use order (the transfer's order is the drape's
-  // locality order: kept, no renumbering).
-  fem::Mesh& mesh = ctx.model.mesh;
-  std::vector<std::int32_t> node_of(rm.n_points(), -1);
-  auto node = [&](std::int64_t point) {  // the mesh node of a result point, made on first use
-    const auto p = static_cast<std::size_t>(point);
-    if (node_of[p] < 0) {
-      node_of[p] = static_cast<std::int32_t>(mesh.n_nodes());
-      for (std::size_t c = 0; c < 3; ++c) mesh.coords.push_back(rm.points[3 * p + c]);
-      mesh.node_user_id.push_back(rm.node_user_id.empty() ? static_cast<std::int64_t>(p + 1)
-                                                          : rm.node_user_id[p]);
-    }
-    return node_of[p];
-  };
   fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
   for (const auto& name : rm.part_names) mesh.add_part(name);
   for (std::size_t h = 0; h < nh; ++h) {
@@ -210,8 +224,14 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
   }
   for (std::size_t k = 0; k < im.classes.size(); ++k)
     if (im.classes[k].n_elements == 0) im.classes[k].name.clear();  // an empty class
+}
 
-  // Kept stitches: bars between tow nodes, the cured yarn's constants after the hexahedra.
+// Kept stitches: bars between tow nodes, the cured yarn's constants after the hexahedra.
+void import_stitches(const TableReader& m, const fem::io::StageFrame& fr, NodeImport& node,
+                     ImpregnatedImport& im) {
+  const auto& rm = fr.mesh;
+  const std::size_t nh = rm.n_hex();
+  fem::Mesh& mesh = node.mesh;
   if (const std::size_t nb = rm.n_bar(); nb > 0) {
     auto bar_value = [&](const char* name) {
       const auto* f = fr.field(name);
@@ -239,17 +259,11 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
     for (std::size_t n = first_stitch_node; n < mesh.n_nodes(); ++n)
       im.stitch_nodes.push_back(static_cast<std::int32_t>(n));
   }
-  mesh.fill_default_user_ids();
-  for (std::size_t p = 0; p < mesh.part_names.size(); ++p) {
-    const auto& name = mesh.part_names[p];
-    const bool stitch = std::find(rm.bar_part.begin(), rm.bar_part.end(),
-                                  static_cast<std::int32_t>(p)) != rm.bar_part.end();
-    ctx.part_kind[name] = stitch ? fem::PartKind::Bar : fem::PartKind::Solid;
-    ctx.generated_parts[name] =
-        stitch ? "[model] (the transfer's kept stitches)" : "[model] (the transfer's plies)";
-  }
+}
 
-  // Tied face pairs, by the transfer's element ids.
+// Tied face pairs, by the transfer's element ids (ties.csv beside its results.h5).
+void import_ties(const TableReader& m, const fem::Mesh& mesh, std::size_t nh,
+                 ImpregnatedImport& im) {
   const auto ties_file = im.source.parent_path() / "ties.csv";
   if (std::filesystem::exists(ties_file)) {
     // Looked up again: adding the bars' set may have moved the hexahedra's.
@@ -281,6 +295,29 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
           {a->second, b->second, r.slave_face, r.master_face});
     }
   }
+}
+
+}  // namespace
+
+ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
+  const TableReader m = ctx.root.required_table("model");
+  ImpregnatedImport im;
+  const fem::io::StageFrame fr = read_source_frame(m, im);
+  const auto& rm = fr.mesh;
+  fem::Mesh& mesh = ctx.model.mesh;
+  NodeImport node(mesh, rm);
+  import_hexahedra(m, fr, node, im);
+  import_stitches(m, fr, node, im);
+  mesh.fill_default_user_ids();
+  for (std::size_t p = 0; p < mesh.part_names.size(); ++p) {
+    const auto& name = mesh.part_names[p];
+    const bool stitch = std::find(rm.bar_part.begin(), rm.bar_part.end(),
+                                  static_cast<std::int32_t>(p)) != rm.bar_part.end();
+    ctx.part_kind[name] = stitch ? fem::PartKind::Bar : fem::PartKind::Solid;
+    ctx.generated_parts[name] =
+        stitch ? "[model] (the transfer's kept stitches)" : "[model] (the transfer's plies)";
+  }
+  import_ties(m, mesh, rm.n_hex(), im);
   return im;
 }
 

@@ -333,9 +333,8 @@ std::vector<BiasCheckRow> bias_check(const std::filesystem::path& dir, const std
   return rows;
 }
 
-}  // namespace
-
-MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
+// calibrate_macro's options from the command line: bad input names the option.
+void check_options(const MacroCalibrationOptions& o) {
   const std::string out = o.output.string();
   if (o.output.empty() || std::filesystem::is_directory(o.output))
     throw InputError(out, "--output", "give a file name for the [[membrane_law]] block");
@@ -352,45 +351,31 @@ MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
   if (!(o.coupon_length > 1.5 * o.coupon_width && o.coupon_width > 0))
     throw InputError("calibrate macro", "--coupon-length",
                      "the bias-extension coupon needs H > 1.5 W > 0");
+}
 
-  MacroCalibration cal;
-  const FrameSource pos = frame_curve(o.positive, "positive", o);
-  const FrameSource neg = frame_curve(o.negative, "negative", o);
-  cal.positive = pos.curve;
-  cal.negative = neg.curve;
-  FrameSource uns;
-  if (!o.unstitched.empty()) {
-    uns = frame_curve(o.unstitched, "--unstitched", o);
-    cal.unstitched = uns.curve;
+// --stitch-bars: the positive curve becomes the tows' share, the frame less its pillars'
+// kinematic force, held monotone (the pillars' force grows faster than the frame's below a few
+// degrees, where both are noise).
+void subtract_pillars(const PillarSource& pillars, MacroCalibration& cal) {
+  double top = 0;
+  int held = 0;
+  for (std::size_t i = 0; i < cal.positive.curve.angle_deg.size(); ++i) {
+    double& f = cal.positive.curve.force[i];
+    f -= pillar_shear_force(pillars.strain, pillars.force, pillars.gauge,
+                            cal.positive.curve.angle_deg[i]);
+    if (f < top || f < 0) ++held;
+    f = std::max({f, top, 0.0});
+    top = f;
   }
-  for (const auto& [what, c] : {std::pair{"positive", &cal.positive},
-                                {"negative", &cal.negative},
-                                {"unstitched", &cal.unstitched}})
-    if (const auto n = clip_note(what, *c); !n.empty()) cal.notes.push_back(n);
-  PillarSource pillars;
-  if (o.stitch_bars) {
-    if (o.symmetric)
-      throw InputError("", "--stitch-bars", "give either --stitch-bars or --symmetric");
-    pillars = pillar_source(o.positive);
-    // The tows' share of the positive frame; held monotone (the pillars' force grows faster
-    // than the frame's below a few degrees, where both are noise).
-    double top = 0;
-    int held = 0;
-    for (std::size_t i = 0; i < cal.positive.curve.angle_deg.size(); ++i) {
-      double& f = cal.positive.curve.force[i];
-      f -= pillar_shear_force(pillars.strain, pillars.force, pillars.gauge,
-                              cal.positive.curve.angle_deg[i]);
-      if (f < top || f < 0) ++held;
-      f = std::max({f, top, 0.0});
-      top = f;
-    }
-    if (held)
-      cal.notes.push_back(
-          fmt::format("positive, less the pillars: {} point(s) held at the running maximum", held));
-  }
-  if (o.symmetric) cal.symmetric = average_curves(cal.positive.curve, cal.negative.curve);
+  if (held)
+    cal.notes.push_back(
+        fmt::format("positive, less the pillars: {} point(s) held at the running maximum", held));
+}
 
-  // The file: where each curve came from, the constants, the block(s).
+// The [[membrane_law]] file: where each curve came from, the constants, the block(s).
+std::string law_file_text(const MacroCalibrationOptions& o, const MacroCalibration& cal,
+                          const FrameSource& pos, const FrameSource& neg, const FrameSource& uns,
+                          const PillarSource& pillars) {
   std::string t = fmt::format(
       "# Macro fabric membrane law calibrated by `ncfsim calibrate macro` (ncfsim {}) from the "
       "meso\n"
@@ -454,8 +439,12 @@ MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
         o.fibre_tension_stiffness, o.fibre_compression_ratio, o.bending_stiffness);
     curve_lines(cal.unstitched.curve, "shear_angle_deg", "shear_force");
   }
+  return t;
+}
 
-  // Optional check against the meso bias-extension runs (comments only).
+// Optional check against the meso bias-extension runs: comments in the file `t`, notes and
+// rows in `cal`.
+void add_bias_checks(const MacroCalibrationOptions& o, MacroCalibration& cal, std::string& t) {
   const double H = o.coupon_length, W = o.coupon_width;
   for (const auto& [dir, sign, rows] :
        {std::tuple{&o.bias_positive, "positive", &cal.bias_positive},
@@ -481,36 +470,73 @@ MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
           r.eq2_shear_deg));
     }
   }
+}
+
+// --curves-csv: the meso curves on the macro grid (a reference for the chain).
+std::string curves_csv_text(const MacroCalibrationOptions& o, const MacroCalibration& cal,
+                            const FrameSource& pos, const FrameSource& neg,
+                            const FrameSource& uns) {
+  std::string csv = fmt::format(
+      "# Meso picture-frame curves on the grid of `ncfsim calibrate macro` (ncfsim {}):\n"
+      "# normalised shear force (N/m) fitted every {} deg (*_fitted: the meso curve; *_macro: "
+      "the\n"
+      "# law's curve, held at the running maximum). Sources:\n#   positive: {}\n#   negative: "
+      "{}\n",
+      kVersion, o.step_deg, pos.text, neg.text);
+  if (!o.unstitched.empty()) csv += "#   unstitched: " + uns.text + "\n";
+  csv += "shear_angle_deg,positive_fitted,positive_macro,negative_fitted,negative_macro";
+  if (!o.unstitched.empty()) csv += ",unstitched_fitted,unstitched_macro";
+  csv += "\n";
+  const auto& grid = cal.positive.curve.angle_deg;
+  auto at = [](const ResampledCurve& c, std::size_t i, bool fit) {
+    const auto& v = fit ? c.fitted : c.curve.force;
+    return i < v.size() ? fmt::format("{:.5g}", v[i]) : std::string();
+  };
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    csv += fmt::format("{:g},{},{},{},{}", grid[i], at(cal.positive, i, true),
+                       at(cal.positive, i, false), at(cal.negative, i, true),
+                       at(cal.negative, i, false));
+    if (!o.unstitched.empty())
+      csv += "," + at(cal.unstitched, i, true) + "," + at(cal.unstitched, i, false);
+    csv += "\n";
+  }
+  return csv;
+}
+
+}  // namespace
+
+MacroCalibration calibrate_macro(const MacroCalibrationOptions& o) {
+  check_options(o);
+  MacroCalibration cal;
+  const FrameSource pos = frame_curve(o.positive, "positive", o);
+  const FrameSource neg = frame_curve(o.negative, "negative", o);
+  cal.positive = pos.curve;
+  cal.negative = neg.curve;
+  FrameSource uns;
+  if (!o.unstitched.empty()) {
+    uns = frame_curve(o.unstitched, "--unstitched", o);
+    cal.unstitched = uns.curve;
+  }
+  for (const auto& [what, c] : {std::pair{"positive", &cal.positive},
+                                {"negative", &cal.negative},
+                                {"unstitched", &cal.unstitched}})
+    if (const auto n = clip_note(what, *c); !n.empty()) cal.notes.push_back(n);
+  PillarSource pillars;
+  if (o.stitch_bars) {
+    if (o.symmetric)
+      throw InputError("", "--stitch-bars", "give either --stitch-bars or --symmetric");
+    pillars = pillar_source(o.positive);
+    subtract_pillars(pillars, cal);
+  }
+  if (o.symmetric) cal.symmetric = average_curves(cal.positive.curve, cal.negative.curve);
+  std::string t = law_file_text(o, cal, pos, neg, uns, pillars);
+  add_bias_checks(o, cal, t);
   if (o.output.has_parent_path()) std::filesystem::create_directories(o.output.parent_path());
   write_file_atomically(o.output, t);
-  if (!o.curves_csv.empty()) {  // the meso curves on the macro grid (a reference for the chain)
-    std::string csv = fmt::format(
-        "# Meso picture-frame curves on the grid of `ncfsim calibrate macro` (ncfsim {}):\n"
-        "# normalised shear force (N/m) fitted every {} deg (*_fitted: the meso curve; *_macro: "
-        "the\n"
-        "# law's curve, held at the running maximum). Sources:\n#   positive: {}\n#   negative: "
-        "{}\n",
-        kVersion, o.step_deg, pos.text, neg.text);
-    if (!o.unstitched.empty()) csv += "#   unstitched: " + uns.text + "\n";
-    csv += "shear_angle_deg,positive_fitted,positive_macro,negative_fitted,negative_macro";
-    if (!o.unstitched.empty()) csv += ",unstitched_fitted,unstitched_macro";
-    csv += "\n";
-    const auto& grid = cal.positive.curve.angle_deg;
-    auto at = [](const ResampledCurve& c, std::size_t i, bool fit) {
-      const auto& v = fit ? c.fitted : c.curve.force;
-      return i < v.size() ? fmt::format("{:.5g}", v[i]) : std::string();
-    };
-    for (std::size_t i = 0; i < grid.size(); ++i) {
-      csv += fmt::format("{:g},{},{},{},{}", grid[i], at(cal.positive, i, true),
-                         at(cal.positive, i, false), at(cal.negative, i, true),
-                         at(cal.negative, i, false));
-      if (!o.unstitched.empty())
-        csv += "," + at(cal.unstitched, i, true) + "," + at(cal.unstitched, i, false);
-      csv += "\n";
-    }
+  if (!o.curves_csv.empty()) {
     if (o.curves_csv.has_parent_path())
       std::filesystem::create_directories(o.curves_csv.parent_path());
-    write_file_atomically(o.curves_csv, csv);
+    write_file_atomically(o.curves_csv, curves_csv_text(o, cal, pos, neg, uns));
   }
   cal.toml = std::move(t);
   return cal;

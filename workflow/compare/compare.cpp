@@ -207,8 +207,10 @@ RingDifference ring_difference(const std::vector<drape::RingSample>& a,
   return d;
 }
 
-int compare_rings(const CompareOptions& opt) {
-  const auto t0 = std::chrono::steady_clock::now();
+namespace {
+
+// The ring the imported files are read on, checked (bad input names the option).
+RingImportOptions checked_import(const CompareOptions& opt) {
   if (opt.sources.empty())
     throw InputError("", "sources", "give at least one run folder or .vtu / .csv file");
   if (opt.out_dir.empty()) throw InputError("", "--output", "an empty output folder");
@@ -230,10 +232,16 @@ int compare_rings(const CompareOptions& opt) {
   }
   if (!(opt.import.tolerance >= 0) || !std::isfinite(opt.import.tolerance))
     throw InputError::out_of_range("", "--tolerance", opt.import.tolerance, Range::non_negative());
+  return imp;
+}
 
-  // Every source first: bad input leaves no output folder.
+// Every source read before anything is written: bad input leaves no output folder. `notes` are
+// logged once the folder (and its log.txt) exists. Labels are made unique (columns of
+// rings.csv, legend entries).
+std::vector<RingSource> read_sources(const CompareOptions& opt, const RingImportOptions& imp,
+                                     std::vector<std::string>& notes) {
+  const drape::RingSpec& ring = imp.ring;
   std::vector<RingSource> sources;
-  std::vector<std::string> notes;  // logged once the folder (and its log.txt) exists
   std::error_code ec;
   for (const auto& arg : opt.sources) {
     auto [label, path] = split_source(arg);
@@ -278,7 +286,6 @@ int compare_rings(const CompareOptions& opt) {
       sources.push_back(std::move(s));
     }
   }
-  // Unique labels (columns of rings.csv, legend entries).
   for (std::size_t i = 0; i < sources.size(); ++i)
     for (int n = 2;; ++n) {
       bool clash = false;
@@ -286,40 +293,27 @@ int compare_rings(const CompareOptions& opt) {
       if (!clash) break;
       sources[i].label += fmt::format(" ({})", n);
     }
+  return sources;
+}
 
-  const OutputFolder folder = OutputFolder::claim(opt.out_dir, opt.overwrite, {}, "comparison");
-  const fs::path& dir = opt.out_dir;
-  auto log = make_run_logger(dir, opt.verbosity);
-  log->info("ncfsim {} | compare | {} source{} -> {}", kVersion, sources.size(),
-            sources.size() == 1 ? "" : "s", dir.string());
-  log->info("ring: {:.4g} m above {} along {}, azimuth 0 along {}, every {:.4g} deg", ring.height,
-            v3(ring.centre), v3(ring.axis), v3(ring.zero_direction), ring.step_deg);
-  for (const auto& n : notes) {
-    if (n.rfind("warning: ", 0) == 0)
-      log->warn("{}", n.substr(9));
-    else
-      log->info("{}", n);
-  }
-
-  // Per source: quadrant maxima.
+// What the comparison writes: summary.json, comparison.csv, pairs.csv, comparison.md.
+struct ComparisonFiles {
   json js = json::object();
-  js["stage"] = "compare";
-  js["ncfsim_version"] = kVersion;
-  js["status"] = "completed";
-  js["ring"] = {{"height_m", ring.height},
-                {"centre_m", ring.centre.arr()},
-                {"axis", ring.axis.arr()},
-                {"zero_direction", ring.zero_direction.arr()},
-                {"step_deg", ring.step_deg}};
-  std::string qcsv =
+  std::string qcsv, pcsv, md;
+};
+
+// Per source: its quadrant maxima (the summary's own keys checked against them).
+void add_source_maxima(const std::vector<RingSource>& sources, const drape::RingSpec& ring,
+                       spdlog::logger& log, ComparisonFiles& f) {
+  f.qcsv =
       "label,kind,source,column,ring_samples,ring_samples_hit,max_shear_deg_q1,max_shear_deg_q2,"
       "max_shear_deg_q3,max_shear_deg_q4\n";
-  std::string md = "# Shear round the ring\n\n";
-  md += fmt::format(
+  f.md = "# Shear round the ring\n\n";
+  f.md += fmt::format(
       "Ring {:.4g} m above {} along the axis {}, azimuth from {} (the wale direction), every "
       "{:.4g} deg; quadrants: the 90 deg sectors centred on 0, 90, 180, 270 deg.\n\n",
       ring.height, v3(ring.centre), v3(ring.axis), v3(ring.zero_direction), ring.step_deg);
-  md +=
+  f.md +=
       "| source | kind | from | azimuths hit | q1 max [deg] | q2 max [deg] | q3 max [deg] | q4 "
       "max [deg] |\n|---|---|---|---|---|---|---|---|\n";
   json jsrc = json::array();
@@ -347,32 +341,35 @@ int compare_rings(const CompareOptions& opt) {
         for (const auto& [key, v] : s.summary_maxima.items())
           if (key.ends_with(fmt::format("q{}", k + 1)) && v.is_number() && std::isfinite(m[k]) &&
               std::abs(v.get<double>() - m[k]) > 1e-3)
-            log->warn("{}: summary.json {} = {:.4f} deg, its ring_shear.csv gives {:.4f} deg",
-                      s.path.string(), key, v.get<double>(), m[k]);
+            log.warn("{}: summary.json {} = {:.4f} deg, its ring_shear.csv gives {:.4f} deg",
+                     s.path.string(), key, v.get<double>(), m[k]);
       }
     }
     if (n_hit < static_cast<int>(s.ring.size()))
-      log->warn("{}: {} of {} azimuths without a value", s.label,
-                static_cast<int>(s.ring.size()) - n_hit, s.ring.size());
+      log.warn("{}: {} of {} azimuths without a value", s.label,
+               static_cast<int>(s.ring.size()) - n_hit, s.ring.size());
     jsrc.push_back(e);
-    qcsv += fmt::format("{},{},{},{},{},{},{},{},{},{}\n", csv_safe(s.label), s.kind,
-                        csv_safe(s.path.string()), csv_safe(s.column), s.ring.size(), n_hit,
-                        cell(m[0], "{:.6g}"), cell(m[1], "{:.6g}"), cell(m[2], "{:.6g}"),
-                        cell(m[3], "{:.6g}"));
-    md += fmt::format("| {} | {} | `{}` | {} / {} | {} | {} | {} | {} |\n", md_safe(s.label),
-                      s.kind, md_safe(s.path.string()), n_hit, s.ring.size(), cell(m[0]),
-                      cell(m[1]), cell(m[2]), cell(m[3]));
-    log->info("{} ({}, {}): max shear q1 {} q2 {} q3 {} q4 {} deg, {} of {} azimuths", s.label,
-              s.kind, s.column, cell(m[0], "{:.2f}"), cell(m[1], "{:.2f}"), cell(m[2], "{:.2f}"),
-              cell(m[3], "{:.2f}"), n_hit, s.ring.size());
+    f.qcsv += fmt::format("{},{},{},{},{},{},{},{},{},{}\n", csv_safe(s.label), s.kind,
+                          csv_safe(s.path.string()), csv_safe(s.column), s.ring.size(), n_hit,
+                          cell(m[0], "{:.6g}"), cell(m[1], "{:.6g}"), cell(m[2], "{:.6g}"),
+                          cell(m[3], "{:.6g}"));
+    f.md += fmt::format("| {} | {} | `{}` | {} / {} | {} | {} | {} | {} |\n", md_safe(s.label),
+                        s.kind, md_safe(s.path.string()), n_hit, s.ring.size(), cell(m[0]),
+                        cell(m[1]), cell(m[2]), cell(m[3]));
+    log.info("{} ({}, {}): max shear q1 {} q2 {} q3 {} q4 {} deg, {} of {} azimuths", s.label,
+             s.kind, s.column, cell(m[0], "{:.2f}"), cell(m[1], "{:.2f}"), cell(m[2], "{:.2f}"),
+             cell(m[3], "{:.2f}"), n_hit, s.ring.size());
   }
-  js["sources"] = jsrc;
+  f.js["sources"] = jsrc;
+}
 
-  // Per pair: differences over the common azimuths.
-  std::string pcsv =
+// Per pair: differences over the common azimuths.
+void add_pair_differences(const std::vector<RingSource>& sources, spdlog::logger& log,
+                          ComparisonFiles& f) {
+  f.pcsv =
       "a,b,azimuths_compared,rms_difference_deg,mean_difference_deg,max_abs_difference_deg,"
       "max_difference_azimuth_deg\n";
-  md +=
+  f.md +=
       "\n| a | b | azimuths compared | RMS (a - b) [deg] | mean (a - b) [deg] | max abs (a - b) "
       "[deg] | at azimuth [deg] |\n|---|---|---|---|---|---|---|\n";
   json jpairs = json::array();
@@ -386,23 +383,25 @@ int compare_rings(const CompareOptions& opt) {
                         {"mean_difference_deg", number_or_null(d.mean_deg)},
                         {"max_abs_difference_deg", number_or_null(d.max_abs_deg)},
                         {"max_difference_azimuth_deg", number_or_null(d.max_at_azimuth_deg)}});
-      pcsv += fmt::format("{},{},{},{},{},{},{}\n", csv_safe(sources[i].label),
-                          csv_safe(sources[j].label), d.azimuths, cell(d.rms_deg, "{:.6g}"),
-                          cell(d.mean_deg, "{:.6g}"), cell(d.max_abs_deg, "{:.6g}"),
-                          cell(d.max_at_azimuth_deg, "{:.6g}"));
-      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", md_safe(sources[i].label),
-                        md_safe(sources[j].label), d.azimuths, cell(d.rms_deg), cell(d.mean_deg),
-                        cell(d.max_abs_deg), cell(d.max_at_azimuth_deg, "{:.0f}"));
-      log->info("{} - {}: RMS {} deg, max {} deg at {} deg over {} azimuths", sources[i].label,
-                sources[j].label, cell(d.rms_deg, "{:.3f}"), cell(d.max_abs_deg, "{:.3f}"),
-                cell(d.max_at_azimuth_deg, "{:.0f}"), d.azimuths);
+      f.pcsv += fmt::format("{},{},{},{},{},{},{}\n", csv_safe(sources[i].label),
+                            csv_safe(sources[j].label), d.azimuths, cell(d.rms_deg, "{:.6g}"),
+                            cell(d.mean_deg, "{:.6g}"), cell(d.max_abs_deg, "{:.6g}"),
+                            cell(d.max_at_azimuth_deg, "{:.6g}"));
+      f.md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", md_safe(sources[i].label),
+                          md_safe(sources[j].label), d.azimuths, cell(d.rms_deg), cell(d.mean_deg),
+                          cell(d.max_abs_deg), cell(d.max_at_azimuth_deg, "{:.0f}"));
+      log.info("{} - {}: RMS {} deg, max {} deg at {} deg over {} azimuths", sources[i].label,
+               sources[j].label, cell(d.rms_deg, "{:.3f}"), cell(d.max_abs_deg, "{:.3f}"),
+               cell(d.max_at_azimuth_deg, "{:.0f}"), d.azimuths);
       if (d.azimuths == 0)
-        log->warn("{} and {}: no azimuth that both hit (rings of another step?)", sources[i].label,
-                  sources[j].label);
+        log.warn("{} and {}: no azimuth that both hit (rings of another step?)", sources[i].label,
+                 sources[j].label);
     }
-  js["pairs"] = jpairs;
+  f.js["pairs"] = jpairs;
+}
 
-  // Every ring on the azimuths of all of them.
+// rings.csv: every ring on the azimuths of all of them.
+std::string rings_csv(const std::vector<RingSource>& sources) {
   std::map<long long, double> azimuths;
   for (const auto& s : sources)
     for (const auto& r : s.ring) azimuths.emplace(std::llround(r.azimuth_deg * 1e6), r.azimuth_deg);
@@ -411,7 +410,10 @@ int compare_rings(const CompareOptions& opt) {
     for (const auto& r : sources[i].ring)
       if (r.hit) value[i][std::llround(r.azimuth_deg * 1e6)] = r.shear_deg;
   std::string rcsv = "azimuth_deg";
-  for (const auto& s : sources) rcsv += "," + csv_safe(s.label);
+  for (const auto& s : sources) {
+    rcsv += ',';
+    rcsv += csv_safe(s.label);
+  }
   rcsv += "\n";
   for (const auto& [key, az] : azimuths) {
     rcsv += fmt::format("{:.6g}", az);
@@ -421,16 +423,12 @@ int compare_rings(const CompareOptions& opt) {
     }
     rcsv += "\n";
   }
+  return rcsv;
+}
 
-  write_file_atomically(dir / "comparison.csv", qcsv);
-  write_file_atomically(dir / "pairs.csv", pcsv);
-  write_file_atomically(dir / "rings.csv", rcsv);
-  for (const auto& s : sources)
-    if (s.kind == "imported")
-      write_file_atomically(dir / ("imported_" + file_safe(s.label) + ".csv"),
-                            drape::ring_csv(s.ring, "shear_deg"));
-
-  // One plot of all rings (the workflow report's ring plot, for any sources).
+// One plot of all rings (the workflow report's ring plot, for any sources).
+void draw_ring_plot(const std::vector<RingSource>& sources, const drape::RingSpec& ring,
+                    const fs::path& dir, spdlog::logger& log, ComparisonFiles& f) {
   render::CurvePlot plot;
   plot.title = fmt::format("Shear angle round the ring at {:.0f} mm", ring.height * 1e3);
   plot.x_label = "azimuth from the wale direction [deg]";
@@ -447,18 +445,63 @@ int compare_rings(const CompareOptions& opt) {
   try {
     fs::create_directories(png.parent_path());
     render::plot_curves_png(plot, png);
-    js["figure"] = "figures/ring_shear_compared.png";
-    md += "\n![rings](figures/ring_shear_compared.png)\n";
+    f.js["figure"] = "figures/ring_shear_compared.png";
+    f.md += "\n![rings](figures/ring_shear_compared.png)\n";
   } catch (const std::exception& e) {
-    js["figure"] = nullptr;
-    js["figure_error"] = e.what();
-    log->warn("the ring plot was not drawn: {}", e.what());
+    f.js["figure"] = nullptr;
+    f.js["figure_error"] = e.what();
+    log.warn("the ring plot was not drawn: {}", e.what());
   }
-  write_file_atomically(dir / "comparison.md", md);
-  js["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_file_atomically(dir / "summary.json", js.dump(2) + "\n");
+}
+
+}  // namespace
+
+int compare_rings(const CompareOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const RingImportOptions imp = checked_import(opt);
+  const drape::RingSpec& ring = imp.ring;
+  std::vector<std::string> notes;
+  const std::vector<RingSource> sources = read_sources(opt, imp, notes);
+
+  const OutputFolder folder = OutputFolder::claim(opt.out_dir, opt.overwrite, {}, "comparison");
+  const fs::path& dir = opt.out_dir;
+  auto log = make_run_logger(dir, opt.verbosity);
+  log->info("ncfsim {} | compare | {} source{} -> {}", kVersion, sources.size(),
+            sources.size() == 1 ? "" : "s", dir.string());
+  log->info("ring: {:.4g} m above {} along {}, azimuth 0 along {}, every {:.4g} deg", ring.height,
+            v3(ring.centre), v3(ring.axis), v3(ring.zero_direction), ring.step_deg);
+  for (const auto& n : notes) {
+    if (n.rfind("warning: ", 0) == 0)
+      log->warn("{}", n.substr(9));
+    else
+      log->info("{}", n);
+  }
+
+  ComparisonFiles f;
+  f.js["stage"] = "compare";
+  f.js["ncfsim_version"] = kVersion;
+  f.js["status"] = "completed";
+  f.js["ring"] = {{"height_m", ring.height},
+                  {"centre_m", ring.centre.arr()},
+                  {"axis", ring.axis.arr()},
+                  {"zero_direction", ring.zero_direction.arr()},
+                  {"step_deg", ring.step_deg}};
+  add_source_maxima(sources, ring, *log, f);
+  add_pair_differences(sources, *log, f);
+  write_file_atomically(dir / "comparison.csv", f.qcsv);
+  write_file_atomically(dir / "pairs.csv", f.pcsv);
+  write_file_atomically(dir / "rings.csv", rings_csv(sources));
+  for (const auto& s : sources)
+    if (s.kind == "imported")
+      write_file_atomically(dir / ("imported_" + file_safe(s.label) + ".csv"),
+                            drape::ring_csv(s.ring, "shear_deg"));
+  draw_ring_plot(sources, ring, dir, *log, f);
+  write_file_atomically(dir / "comparison.md", f.md);
+  f.js["wall_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  write_file_atomically(dir / "summary.json", f.js.dump(2) + "\n");
   log->info("wrote comparison.csv, pairs.csv, comparison.md, rings.csv, summary.json{}",
-            js["figure"].is_null() ? "" : ", figures/ring_shear_compared.png");
+            f.js["figure"].is_null() ? "" : ", figures/ring_shear_compared.png");
   folder.finish();
   return kSuccess;
 }

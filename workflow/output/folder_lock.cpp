@@ -10,9 +10,9 @@
 #include <cstring>
 #include <ctime>
 #include <fstream>
-#include <sstream>
 
 #include "fem/errors.hpp"
+#include "workflow/output/output_files.hpp"
 
 namespace ncfsim::workflow {
 
@@ -129,12 +129,7 @@ bool FolderLock::held(const std::filesystem::path& dir) {
 }
 
 nlohmann::json FolderLock::last_holder(const std::filesystem::path& dir) {
-  std::ifstream in(dir / kFolderLockFile);
-  if (!in) return nullptr;
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const auto h = nlohmann::json::parse(ss.str(), nullptr, false);
-  return h.is_discarded() ? nlohmann::json(nullptr) : h;
+  return read_json_file(dir / kFolderLockFile);
 }
 
 FolderLock::~FolderLock() {

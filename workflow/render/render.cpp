@@ -599,63 +599,45 @@ RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop) 
   return without_cells(mesh, cells);
 }
 
-void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
-                     const std::filesystem::path& png) {
-  const std::string where = "render_mesh_png('" + png.string() + "')";
-  check_size(where, figure.width, figure.height);
-  validate_mesh(mesh, where);
-  const bool coloured = !figure.field.empty();
-  Scalars scalars;
-  std::array<double, 2> range{0.0, 1.0};
-  if (coloured) {
-    scalars = select_scalars(mesh, figure, where);
-    range = colour_range(scalars, figure, where);
-    if (!figure.categories.empty())
-      range = {0.0, static_cast<double>(figure.categories.size() - 1)};
-  }
+namespace {
 
-  std::lock_guard lock(render_mutex());
-  OffscreenWindow ow(figure.width, figure.height, where);
-
-  // Geometry: the same points for the solid part, the bars and the shells.
-  const std::size_t n_points = mesh.points.size() / 3;
-  const std::size_t n_hex = mesh.hex8.size() / 8;
-  const std::size_t n_bar = mesh.bar2.size() / 2;
-  const std::size_t n_quad = mesh.quad4.size() / 4;
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(static_cast<vtkIdType>(n_points));
-  for (std::size_t i = 0; i < n_points; ++i) {
-    points->SetPoint(static_cast<vtkIdType>(i), mesh.points.data() + 3 * i);
-  }
-  vtkSmartPointer<vtkLookupTable> lut = make_lookup_table(range);
-  if (!figure.categories.empty()) {
-    // One colour per category (the first, "none", light grey), named on the bar.
-    const auto n = static_cast<vtkIdType>(figure.categories.size());
-    lut = vtkSmartPointer<vtkLookupTable>::New();
-    lut->SetNumberOfTableValues(n);
-    lut->SetTableRange(range[0], range[1]);
-    lut->Build();
-    for (vtkIdType k = 0; k < n; ++k) {
-      if (k == 0) {
-        lut->SetTableValue(0, 0.85, 0.85, 0.85, 1.0);
-      } else {
-        double rgb[3];
-        const double h =
-            n > 2 ? 0.6667 * (1.0 - static_cast<double>(k - 1) / static_cast<double>(n - 2)) : 0.0;
-        vtkMath::HSVToRGB(h, 1.0, 1.0, rgb, rgb + 1, rgb + 2);
-        lut->SetTableValue(k, rgb[0], rgb[1], rgb[2], 1.0);
-      }
-      lut->SetAnnotation(vtkVariant(static_cast<double>(k)),
-                         figure.categories[static_cast<std::size_t>(k)]);
+// One colour per category (the first, "none", light grey), named on the bar.
+vtkSmartPointer<vtkLookupTable> category_lookup_table(const std::vector<std::string>& categories,
+                                                      const std::array<double, 2>& range) {
+  const auto n = static_cast<vtkIdType>(categories.size());
+  auto lut = vtkSmartPointer<vtkLookupTable>::New();
+  lut->SetNumberOfTableValues(n);
+  lut->SetTableRange(range[0], range[1]);
+  lut->Build();
+  for (vtkIdType k = 0; k < n; ++k) {
+    if (k == 0) {
+      lut->SetTableValue(0, 0.85, 0.85, 0.85, 1.0);
+    } else {
+      double rgb[3];
+      const double h =
+          n > 2 ? 0.6667 * (1.0 - static_cast<double>(k - 1) / static_cast<double>(n - 2)) : 0.0;
+      vtkMath::HSVToRGB(h, 1.0, 1.0, rgb, rgb + 1, rgb + 2);
+      lut->SetTableValue(k, rgb[0], rgb[1], rgb[2], 1.0);
     }
-    lut->IndexedLookupOn();
+    lut->SetAnnotation(vtkVariant(static_cast<double>(k)), categories[static_cast<std::size_t>(k)]);
   }
-  vtkSmartPointer<vtkDoubleArray> point_scalars;
-  if (coloured && !scalars.on_cells) {
-    point_scalars = make_array(figure.field, scalars.values.data(), n_points);
-  }
-  auto configure_mapper = [&](vtkPolyDataMapper* mapper) {
+  lut->IndexedLookupOn();
+  return lut;
+}
+
+// What the three kinds' actors share: the points, the colouring and its field.
+struct MeshColouring {
+  MeshColouring(const MeshFigure& f, const Scalars& s)
+      : figure(f), coloured(!f.field.empty()), scalars(s) {}
+  const MeshFigure& figure;
+  bool coloured = false;
+  const Scalars& scalars;
+  std::array<double, 2> range{0.0, 1.0};
+  vtkSmartPointer<vtkLookupTable> lut;
+  vtkSmartPointer<vtkDoubleArray> point_scalars;  // a nodal field (null: a cell field or none)
+  vtkSmartPointer<vtkPoints> points;
+
+  void configure(vtkPolyDataMapper* mapper) const {
     if (!coloured) {
       mapper->ScalarVisibilityOff();
       return;
@@ -671,129 +653,123 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
       mapper->SetScalarModeToUsePointData();
       mapper->InterpolateScalarsBeforeMappingOn();  // colour bands follow the map, not RGB blends
     }
-  };
-
-  vtkNew<vtkRenderer> scene;
-  scene->SetViewport(0.0, 0.0, 0.82, 0.92);
-  scene->SetLayer(1);  // drawn over the annotation layer's background, no clear of its own
-  scene->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
-  scene->UseFXAAOff();
-
-  vtkNew<vtkPolyData> solid;  // boundary quads of the hexahedra
-  vtkNew<vtkPolyDataMapper> solid_mapper;
-  vtkNew<vtkActor> solid_actor;
-  if (n_hex > 0) {
-    const BoundaryQuads quads = boundary_quads(mesh.hex8);
-    const auto n_faces = static_cast<vtkIdType>(quads.hex.size());
-    vtkNew<vtkCellArray> polys;
-    polys->AllocateExact(n_faces, 4 * n_faces);
-    for (vtkIdType f = 0; f < n_faces; ++f) {
-      polys->InsertNextCell(4, quads.nodes.data() + 4 * f);
-    }
-    solid->SetPoints(points);
-    solid->SetPolys(polys);
-    if (point_scalars) {
-      solid->GetPointData()->SetScalars(point_scalars);
-    } else if (coloured) {
-      std::vector<double> face_values(quads.hex.size());
-      for (std::size_t f = 0; f < quads.hex.size(); ++f) {
-        face_values[f] = scalars.values[quads.hex[f]];
-      }
-      solid->GetCellData()->SetScalars(
-          make_array(figure.field, face_values.data(), face_values.size()));
-    }
-    solid_mapper->SetInputData(solid);
-    configure_mapper(solid_mapper);
-    solid_actor->SetMapper(solid_mapper);
-    vtkProperty* p = solid_actor->GetProperty();
-    // Faces facing the camera show the colour map's exact colours (0.25 + 0.75 = 1); oblique
-    // faces in the Iso view keep 60-80 % of their brightness.
-    p->SetAmbient(0.25);
-    p->SetDiffuse(0.75);
-    p->SetSpecular(0.0);
-    if (!coloured) {
-      p->SetColor(0.78, 0.80, 0.84);
-    }
-    scene->AddActor(solid_actor);
   }
-
-  vtkNew<vtkPolyData> shells;  // the shells' mid-surfaces
-  vtkNew<vtkPolyDataMapper> shell_mapper;
-  vtkNew<vtkActor> shell_actor;
-  if (n_quad > 0) {
-    vtkNew<vtkCellArray> polys;
-    polys->AllocateExact(static_cast<vtkIdType>(n_quad), static_cast<vtkIdType>(4 * n_quad));
-    for (std::size_t q = 0; q < n_quad; ++q) {
-      vtkIdType ids[4];
-      for (std::size_t k = 0; k < 4; ++k) {
-        ids[k] = static_cast<vtkIdType>(mesh.quad4[4 * q + k]);
-      }
-      polys->InsertNextCell(4, ids);
-    }
-    shells->SetPoints(points);
-    shells->SetPolys(polys);
-    if (point_scalars) {
-      shells->GetPointData()->SetScalars(point_scalars);
-    } else if (coloured) {
-      shells->GetCellData()->SetScalars(
-          make_array(figure.field, scalars.values.data() + n_hex + n_bar, n_quad));
-    }
-    shell_mapper->SetInputData(shells);
-    configure_mapper(shell_mapper);
-    shell_actor->SetMapper(shell_mapper);
-    vtkProperty* p = shell_actor->GetProperty();
-    // As the hexahedra's faces; the renderer's two-sided lighting (VTK's default) lights a shell
-    // seen from below as one seen from above.
-    p->SetAmbient(0.25);
-    p->SetDiffuse(0.75);
-    p->SetSpecular(0.0);
-    if (!coloured) {
-      p->SetColor(0.78, 0.80, 0.84);
-    }
-    scene->AddActor(shell_actor);
+  // The field on `poly`: the nodal array, or the cell field's values first_cell.. (+n).
+  void colour(vtkPolyData* poly, std::size_t first_cell, std::size_t n) const {
+    if (point_scalars)
+      poly->GetPointData()->SetScalars(point_scalars);
+    else if (coloured)
+      poly->GetCellData()->SetScalars(
+          make_array(figure.field, scalars.values.data() + first_cell, n));
   }
+  vtkSmartPointer<vtkActor> actor_of(vtkPolyData* poly) const {
+    vtkNew<vtkPolyDataMapper> mapper;
+    mapper->SetInputData(poly);
+    configure(mapper);
+    auto actor = vtkSmartPointer<vtkActor>::New();
+    actor->SetMapper(mapper);
+    return actor;
+  }
+};
 
+// The hexahedra's boundary quads.
+vtkSmartPointer<vtkActor> solid_actor(const RenderMesh& mesh, const MeshColouring& c) {
+  const BoundaryQuads quads = boundary_quads(mesh.hex8);
+  const auto n_faces = static_cast<vtkIdType>(quads.hex.size());
+  vtkNew<vtkCellArray> polys;
+  polys->AllocateExact(n_faces, 4 * n_faces);
+  for (vtkIdType f = 0; f < n_faces; ++f) {
+    polys->InsertNextCell(4, quads.nodes.data() + 4 * f);
+  }
+  vtkNew<vtkPolyData> solid;
+  solid->SetPoints(c.points);
+  solid->SetPolys(polys);
+  if (c.point_scalars) {
+    solid->GetPointData()->SetScalars(c.point_scalars);
+  } else if (c.coloured) {  // each face its hexahedron's value
+    std::vector<double> face_values(quads.hex.size());
+    for (std::size_t f = 0; f < quads.hex.size(); ++f) {
+      face_values[f] = c.scalars.values[quads.hex[f]];
+    }
+    solid->GetCellData()->SetScalars(
+        make_array(c.figure.field, face_values.data(), face_values.size()));
+  }
+  auto actor = c.actor_of(solid);
+  vtkProperty* p = actor->GetProperty();
+  // Faces facing the camera show the colour map's exact colours (0.25 + 0.75 = 1); oblique
+  // faces in the Iso view keep 60-80 % of their brightness.
+  p->SetAmbient(0.25);
+  p->SetDiffuse(0.75);
+  p->SetSpecular(0.0);
+  if (!c.coloured) {
+    p->SetColor(0.78, 0.80, 0.84);
+  }
+  return actor;
+}
+
+// The shells' mid-surfaces.
+vtkSmartPointer<vtkActor> shell_actor(const RenderMesh& mesh, const MeshColouring& c,
+                                      std::size_t n_hex, std::size_t n_bar) {
+  const std::size_t n_quad = mesh.quad4.size() / 4;
+  vtkNew<vtkCellArray> polys;
+  polys->AllocateExact(static_cast<vtkIdType>(n_quad), static_cast<vtkIdType>(4 * n_quad));
+  for (std::size_t q = 0; q < n_quad; ++q) {
+    vtkIdType ids[4];
+    for (std::size_t k = 0; k < 4; ++k) {
+      ids[k] = static_cast<vtkIdType>(mesh.quad4[4 * q + k]);
+    }
+    polys->InsertNextCell(4, ids);
+  }
+  vtkNew<vtkPolyData> shells;
+  shells->SetPoints(c.points);
+  shells->SetPolys(polys);
+  c.colour(shells, n_hex + n_bar, n_quad);
+  auto actor = c.actor_of(shells);
+  vtkProperty* p = actor->GetProperty();
+  // As the hexahedra's faces; the renderer's two-sided lighting (VTK's default) lights a shell
+  // seen from below as one seen from above.
+  p->SetAmbient(0.25);
+  p->SetDiffuse(0.75);
+  p->SetSpecular(0.0);
+  if (!c.coloured) {
+    p->SetColor(0.78, 0.80, 0.84);
+  }
+  return actor;
+}
+
+// The bars, as lines.
+vtkSmartPointer<vtkActor> bar_actor(const RenderMesh& mesh, const MeshColouring& c,
+                                    std::size_t n_hex) {
+  const std::size_t n_bar = mesh.bar2.size() / 2;
+  vtkNew<vtkCellArray> lines;
+  lines->AllocateExact(static_cast<vtkIdType>(n_bar), static_cast<vtkIdType>(2 * n_bar));
+  for (std::size_t b = 0; b < n_bar; ++b) {
+    const vtkIdType ids[2] = {static_cast<vtkIdType>(mesh.bar2[2 * b]),
+                              static_cast<vtkIdType>(mesh.bar2[2 * b + 1])};
+    lines->InsertNextCell(2, ids);
+  }
   vtkNew<vtkPolyData> bars;
-  vtkNew<vtkPolyDataMapper> bar_mapper;
-  vtkNew<vtkActor> bar_actor;
-  if (n_bar > 0) {
-    vtkNew<vtkCellArray> lines;
-    lines->AllocateExact(static_cast<vtkIdType>(n_bar), static_cast<vtkIdType>(2 * n_bar));
-    for (std::size_t b = 0; b < n_bar; ++b) {
-      const vtkIdType ids[2] = {static_cast<vtkIdType>(mesh.bar2[2 * b]),
-                                static_cast<vtkIdType>(mesh.bar2[2 * b + 1])};
-      lines->InsertNextCell(2, ids);
-    }
-    bars->SetPoints(points);
-    bars->SetLines(lines);
-    if (point_scalars) {
-      bars->GetPointData()->SetScalars(point_scalars);
-    } else if (coloured) {
-      bars->GetCellData()->SetScalars(
-          make_array(figure.field, scalars.values.data() + n_hex, n_bar));
-    }
-    bar_mapper->SetInputData(bars);
-    configure_mapper(bar_mapper);
-    // Lines in front of coincident hex faces and shells (bars on a surface stay visible).
-    bar_mapper->SetResolveCoincidentTopologyToPolygonOffset();
-    bar_actor->SetMapper(bar_mapper);
-    vtkProperty* p = bar_actor->GetProperty();
-    p->SetLineWidth(std::max(2.0f, static_cast<float>(figure.height) / 300.0f));
-    p->LightingOff();
-    if (!coloured) {
-      p->SetColor(0.15, 0.15, 0.2);
-    }
-    scene->AddActor(bar_actor);
+  bars->SetPoints(c.points);
+  bars->SetLines(lines);
+  c.colour(bars, n_hex, n_bar);
+  auto actor = c.actor_of(bars);
+  // Lines in front of coincident hex faces and shells (bars on a surface stay visible).
+  actor->GetMapper()->SetResolveCoincidentTopologyToPolygonOffset();
+  vtkProperty* p = actor->GetProperty();
+  p->SetLineWidth(std::max(2.0f, static_cast<float>(c.figure.height) / 300.0f));
+  p->LightingOff();
+  if (!c.coloured) {
+    p->SetColor(0.15, 0.15, 0.2);
   }
-  apply_camera(scene, figure.camera, figure.focus_bounds);
+  return actor;
+}
 
-  // Annotation layer: full window, owns the background, holds the title and the scalar bar.
-  vtkNew<vtkRenderer> annotation;
-  annotation->SetViewport(0.0, 0.0, 1.0, 1.0);
-  annotation->SetLayer(0);
-  annotation->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
-  annotation->InteractiveOff();
-
+// The annotation layer's title and scalar bar.
+void add_title_and_scalar_bar(vtkRenderer* annotation, const MeshColouring& c) {
+  const MeshFigure& figure = c.figure;
+  const bool coloured = c.coloured;
+  const Scalars& scalars = c.scalars;
+  const vtkSmartPointer<vtkLookupTable>& lut = c.lut;
   vtkNew<vtkTextActor> title;
   if (!figure.title.empty()) {
     title->SetInput(figure.title.c_str());
@@ -855,6 +831,61 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
     bar_title->GetPositionCoordinate()->SetValue(0.985, 0.915);
     annotation->AddActor2D(bar_title);
   }
+}
+
+}  // namespace
+
+void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
+                     const std::filesystem::path& png) {
+  const std::string where = "render_mesh_png('" + png.string() + "')";
+  check_size(where, figure.width, figure.height);
+  validate_mesh(mesh, where);
+  Scalars scalars;
+  MeshColouring c(figure, scalars);
+  if (c.coloured) {
+    scalars = select_scalars(mesh, figure, where);
+    c.range = colour_range(scalars, figure, where);
+    if (!figure.categories.empty())
+      c.range = {0.0, static_cast<double>(figure.categories.size() - 1)};
+  }
+
+  std::lock_guard lock(render_mutex());
+  OffscreenWindow ow(figure.width, figure.height, where);
+
+  // Geometry: the same points for the solid part, the bars and the shells.
+  const std::size_t n_points = mesh.points.size() / 3;
+  const std::size_t n_hex = mesh.hex8.size() / 8;
+  const std::size_t n_bar = mesh.bar2.size() / 2;
+  const std::size_t n_quad = mesh.quad4.size() / 4;
+  c.points = vtkSmartPointer<vtkPoints>::New();
+  c.points->SetDataTypeToDouble();
+  c.points->SetNumberOfPoints(static_cast<vtkIdType>(n_points));
+  for (std::size_t i = 0; i < n_points; ++i) {
+    c.points->SetPoint(static_cast<vtkIdType>(i), mesh.points.data() + 3 * i);
+  }
+  c.lut = figure.categories.empty() ? make_lookup_table(c.range)
+                                    : category_lookup_table(figure.categories, c.range);
+  if (c.coloured && !scalars.on_cells) {
+    c.point_scalars = make_array(figure.field, scalars.values.data(), n_points);
+  }
+
+  vtkNew<vtkRenderer> scene;
+  scene->SetViewport(0.0, 0.0, 0.82, 0.92);
+  scene->SetLayer(1);  // drawn over the annotation layer's background, no clear of its own
+  scene->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
+  scene->UseFXAAOff();
+  if (n_hex > 0) scene->AddActor(solid_actor(mesh, c));
+  if (n_quad > 0) scene->AddActor(shell_actor(mesh, c, n_hex, n_bar));
+  if (n_bar > 0) scene->AddActor(bar_actor(mesh, c, n_hex));
+  apply_camera(scene, figure.camera, figure.focus_bounds);
+
+  // Annotation layer: full window, owns the background, holds the title and the scalar bar.
+  vtkNew<vtkRenderer> annotation;
+  annotation->SetViewport(0.0, 0.0, 1.0, 1.0);
+  annotation->SetLayer(0);
+  annotation->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
+  annotation->InteractiveOff();
+  add_title_and_scalar_bar(annotation, c);
 
   vtkGenericOpenGLRenderWindow* window = ow.window();
   window->SetNumberOfLayers(2);
