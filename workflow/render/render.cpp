@@ -670,6 +670,21 @@ struct MeshColouring {
     actor->SetMapper(mapper);
     return actor;
   }
+  // A lit surface (the hexahedra's faces, the shells): faces facing the camera show the colour
+  // map's exact colours (0.25 + 0.75 = 1); oblique faces in the Iso view keep 60-80 % of their
+  // brightness; the renderer's two-sided lighting (VTK's default) lights a shell seen from below
+  // as one seen from above.
+  vtkSmartPointer<vtkActor> surface_actor_of(vtkPolyData* poly) const {
+    auto actor = actor_of(poly);
+    vtkProperty* p = actor->GetProperty();
+    p->SetAmbient(0.25);
+    p->SetDiffuse(0.75);
+    p->SetSpecular(0.0);
+    if (!coloured) {
+      p->SetColor(0.78, 0.80, 0.84);
+    }
+    return actor;
+  }
 };
 
 // The hexahedra's boundary quads.
@@ -694,17 +709,7 @@ vtkSmartPointer<vtkActor> solid_actor(const RenderMesh& mesh, const MeshColourin
     solid->GetCellData()->SetScalars(
         make_array(c.figure.field, face_values.data(), face_values.size()));
   }
-  auto actor = c.actor_of(solid);
-  vtkProperty* p = actor->GetProperty();
-  // Faces facing the camera show the colour map's exact colours (0.25 + 0.75 = 1); oblique
-  // faces in the Iso view keep 60-80 % of their brightness.
-  p->SetAmbient(0.25);
-  p->SetDiffuse(0.75);
-  p->SetSpecular(0.0);
-  if (!c.coloured) {
-    p->SetColor(0.78, 0.80, 0.84);
-  }
-  return actor;
+  return c.surface_actor_of(solid);
 }
 
 // The shells' mid-surfaces.
@@ -724,17 +729,7 @@ vtkSmartPointer<vtkActor> shell_actor(const RenderMesh& mesh, const MeshColourin
   shells->SetPoints(c.points);
   shells->SetPolys(polys);
   c.colour(shells, n_hex + n_bar, n_quad);
-  auto actor = c.actor_of(shells);
-  vtkProperty* p = actor->GetProperty();
-  // As the hexahedra's faces; the renderer's two-sided lighting (VTK's default) lights a shell
-  // seen from below as one seen from above.
-  p->SetAmbient(0.25);
-  p->SetDiffuse(0.75);
-  p->SetSpecular(0.0);
-  if (!c.coloured) {
-    p->SetColor(0.78, 0.80, 0.84);
-  }
-  return actor;
+  return c.surface_actor_of(shells);
 }
 
 // The bars, as lines.
