@@ -68,8 +68,11 @@ struct TimeControl {
   double safety_factor = 0.9;
   double mass_scaling_dt = 0;       // 0: off; else elements below this step get added mass
   // Mass scaling again during the run: a hexahedron whose step falls below mass_scaling_dt gets
-  // mass so that it is back 5 % above it (dynamic mass scaling, as forming codes do).
+  // mass so that it is back 5 % above it (dynamic mass scaling, as forming codes do), up to
+  // mass_scaling_max_ratio times its physical mass added; beyond, its step falls (and it is
+  // eroded at erosion_step_ratio): a folding element would otherwise take mass without bound.
   bool mass_scaling_dynamic = false;
+  double mass_scaling_max_ratio = 10.0;
   double history_interval = 0;      // 0: 200 rows over the run
   double frame_interval = 0;        // 0: 20 frames over the run
   std::int64_t max_cycles = 0;      // 0: unlimited

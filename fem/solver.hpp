@@ -126,6 +126,9 @@ class ExplicitSolver {
   }
   /// Dynamic mass scaling (time.mass_scaling_dynamic): the cycles in which mass was added.
   std::int64_t mass_scaling_events() const { return mass_scaling_events_; }
+  /// Hexahedra (all ranks) whose added mass has reached time.mass_scaling_max_ratio: their step
+  /// is their own again.
+  std::int64_t mass_scaling_capped() const { return mass_scaling_capped_; }
   /// Several ranks: how many times the contact halo was built again as the nodes moved
   /// (parallel.contact_halo_refresh; since the start or the resume).
   std::int64_t contact_halo_builds() const { return halo_builds_; }
@@ -312,6 +315,9 @@ class ExplicitSolver {
   void build_contact_halo(double* x, double* v);
   // Dynamic mass scaling (time.mass_scaling_dynamic): events so far and the work array.
   std::int64_t mass_scaling_events_ = 0;
+  // No scan before this cycle: the last found every hexahedron below the target at the cap.
+  std::int64_t mass_scaling_pause_until_ = 0;
+  std::int64_t mass_scaling_capped_ = 0;  // hexahedra at the cap (all ranks), as of the last scan
   double mass_scaling_work_ = 0;  // this cycle's, on held nodes (booked as external work)
   std::vector<double> added_mass_scratch_;
   void scale_mass_dynamic(double* x, double* v, double* m);

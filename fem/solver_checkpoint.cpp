@@ -48,6 +48,8 @@ void ExplicitSolver::save_state(CheckpointWriter& w) const {
       for (const auto& pm : part_mass_) added.push_back(pm.added_mass);
       save_array(w, "part_added_mass", added);
       w.write_int("mass_scaling_events", mass_scaling_events_);
+      w.write_int("mass_scaling_pause_until", mass_scaling_pause_until_);
+      w.write_int("mass_scaling_capped", mass_scaling_capped_);
     }
   }
   w.write_double("t", t_);
@@ -156,6 +158,10 @@ void ExplicitSolver::load_state(CheckpointReader& r) {
       r.read_array("part_added_mass", a, part_mass_.size());
       for (std::size_t p = 0; p < part_mass_.size(); ++p) part_mass_[p].added_mass = a[p];
       mass_scaling_events_ = r.read_int("mass_scaling_events");
+      if (r.has("mass_scaling_pause_until")) {
+        mass_scaling_pause_until_ = r.read_int("mass_scaling_pause_until");
+        mass_scaling_capped_ = r.read_int("mass_scaling_capped");
+      }
     }
   }
   if (r.read_double("dt_initial") != dt_initial_)

@@ -261,8 +261,12 @@ void ExplicitSolver::assemble_mass() {
 
 // Dynamic mass scaling: when the last cycle's step (the same on every rank) was set by a
 // hexahedron below time.mass_scaling_dt, every hexahedron of this rank below it gets the mass
-// that puts its step 5 % above (so that a locking element is not scaled every cycle), added to
-// its nodes; on several ranks the owners sum what their ghosts got. A free node that gains mass
+// that puts its step 5 % above (so that a locking element is not scaled every cycle), up to
+// time.mass_scaling_max_ratio times its physical mass, added to its nodes; on several ranks the
+// owners sum what their ghosts got. An element at that cap is left to its own step (a folding
+// element's falls without bound; erosion_step_ratio takes it): when a scan finds only such
+// elements below the target, the next is 50 cycles later (as the erosion checks), so a capped
+// element that sets the step does not cost a scan every cycle. A free node that gains mass
 // keeps its kinetic energy (its velocity scaled by sqrt(m / (m + dm))): the added inertia brings
 // no energy of its own, and the momentum of those nodes drops by that factor (in quasi-static
 // forming a share of a small term). A node held at a prescribed velocity keeps it: the fixture
@@ -271,19 +275,33 @@ void ExplicitSolver::assemble_mass() {
 void ExplicitSolver::scale_mass_dynamic(double* x, double* v, double* m) {
   const double target = model_.time.mass_scaling_dt, sf = model_.time.safety_factor;
   if (cycle_ == 0 || step_.kind != ElementKind::Hex8 || !(sf * step_.dt < target)) return;
+  if (cycle_ < mass_scaling_pause_until_) return;
   constexpr double kHeadroom = 1.05;
+  constexpr std::int64_t kPauseCycles = 50;
   const std::size_t n = model_.mesh.n_nodes();
   std::vector<double>& dm = added_mass_scratch_;
   dm.assign(3 * n, 0.0);
-  std::vector<double> added(part_mass_.size(), 0.0);
-  for (const auto& g : groups_)
-    added[static_cast<std::size_t>(g->part())] +=
-        g->scale_mass_dynamic(x, target, sf, kHeadroom, dm.data());
-  if (domain_) {
-    domain_->add_ghosts_to_owners(dm.data(), nullptr);
+  // Per part the mass added, then the elements scaled, those held at the cap below the target
+  // and all at the cap (all ranks).
+  const std::size_t n_part = part_mass_.size();
+  std::vector<double> added(n_part + 3, 0.0);
+  for (const auto& g : groups_) {
+    const DynamicScalingResult r = g->scale_mass_dynamic(
+        x, target, sf, kHeadroom, model_.time.mass_scaling_max_ratio, dm.data());
+    added[static_cast<std::size_t>(g->part())] += r.added_mass;
+    added[n_part] += static_cast<double>(r.scaled);
+    added[n_part + 1] += static_cast<double>(r.held_at_cap);
+    added[n_part + 2] += static_cast<double>(r.at_cap);
+  }
+  if (domain_)
     MPI_Allreduce(MPI_IN_PLACE, added.data(), static_cast<int>(added.size()), MPI_DOUBLE, MPI_SUM,
                   domain_->comm());
+  mass_scaling_capped_ = static_cast<std::int64_t>(added[n_part + 2]);
+  if (!(added[n_part] > 0)) {
+    if (added[n_part + 1] > 0) mass_scaling_pause_until_ = cycle_ + kPauseCycles;
+    return;
   }
+  if (domain_) domain_->add_ghosts_to_owners(dm.data(), nullptr);
   const auto scale = [&](std::size_t b, std::size_t e) {
     for (std::size_t d = 3 * b; d < 3 * e; ++d) {
       if (!(dm[d] > 0)) continue;
@@ -301,7 +319,7 @@ void ExplicitSolver::scale_mass_dynamic(double* x, double* v, double* m) {
   } else {
     scale(0, n);
   }
-  for (std::size_t p = 0; p < added.size(); ++p) part_mass_[p].added_mass += added[p];
+  for (std::size_t p = 0; p < n_part; ++p) part_mass_[p].added_mass += added[p];
   ++mass_scaling_events_;
 }
 

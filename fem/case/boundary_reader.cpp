@@ -121,6 +121,8 @@ void read_time(CaseReadContext& ctx) {
   if (time.mass_scaling_dynamic && !(time.mass_scaling_dt > 0))
     tc.fail("mass_scaling_dynamic",
             "dynamic mass scaling needs its target step: set time.mass_scaling_dt > 0");
+  time.mass_scaling_max_ratio =
+      tc.number("mass_scaling_max_ratio", 10.0, Range::open_closed(0, 1e6));
   time.history_interval = tc.number("history_interval", time.end_time / 200, Range::positive());
   time.frame_interval = tc.number("frame_interval", time.end_time / 20, Range::positive());
   time.max_cycles = tc.integer("max_cycles", 0, 0, std::int64_t{1} << 50);

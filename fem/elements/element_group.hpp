@@ -34,6 +34,16 @@ struct CellFieldSpec {
   int components = 1;
 };
 
+/// What one pass of dynamic mass scaling did on a group: the mass added (kg), the elements
+/// scaled, those below the target that the cap on added mass left as they were, and all those
+/// at the cap after the pass.
+struct DynamicScalingResult {
+  double added_mass = 0;
+  std::int64_t scaled = 0;
+  std::int64_t held_at_cap = 0;
+  std::int64_t at_cap = 0;
+};
+
 class ElementGroup {
  public:
   virtual ~ElementGroup() = default;
@@ -54,13 +64,15 @@ class ElementGroup {
   /// Adds mass where an element's step (times safety) is below target_dt, so that it reaches it.
   virtual void scale_mass(const double* x, double target_dt, double safety) = 0;
   /// Dynamic mass scaling: each element of this rank's range whose step at x (times safety) is
-  /// below 1.02 target_dt gets the density that puts it at `headroom` times target_dt; its added
-  /// mass goes to its nodes in dm [3*n_nodes] (an eighth each for a hexahedron). Returns the mass
-  /// added (kg). Kinds that do not scale during a run add nothing.
-  virtual double scale_mass_dynamic(const double* x, double target_dt, double safety,
-                                    double headroom, double* dm) {
-    (void)x, (void)target_dt, (void)safety, (void)headroom, (void)dm;
-    return 0.0;
+  /// below target_dt gets the density that puts it at `headroom` times target_dt, but no more
+  /// than (1 + max_added_ratio) times its material's density (then its step falls below the
+  /// target); its added mass goes to its nodes in dm [3*n_nodes] (an eighth each for a
+  /// hexahedron). Kinds that do not scale during a run add nothing.
+  virtual DynamicScalingResult scale_mass_dynamic(const double* x, double target_dt, double safety,
+                                                  double headroom, double max_added_ratio,
+                                                  double* dm) {
+    (void)x, (void)target_dt, (void)safety, (void)headroom, (void)max_added_ratio, (void)dm;
+    return {};
   }
   /// Stable step of the group's controlling element at positions x.
   virtual StableStep stable_step(const double* x) const = 0;

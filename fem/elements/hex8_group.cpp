@@ -36,25 +36,36 @@ class Hex8Group final : public ElementGroup {
     for (std::size_t e = 0; e < block.n; ++e)
       if (sf * dt[e] < target) block.density[e] *= std::pow(target / (sf * dt[e]), 2);
   }
-  double scale_mass_dynamic(const double* x, double target, double sf, double headroom,
-                            double* dm) override {
+  DynamicScalingResult scale_mass_dynamic(const double* x, double target, double sf,
+                                          double headroom, double max_added_ratio,
+                                          double* dm) override {
     std::vector<double> dt;
     hex8_element_steps(block, x, dt, nullptr, true);
-    double added = 0;
-    for (std::size_t e = 0; e < block.n; ++e) {
-      // Below the target, or within 2 % of it: elements closing on it together are scaled
-      // together, not one event each (out of range or eroded: 1e300).
-      if (!(sf * dt[e] < 1.02 * target)) continue;
-      const double factor = std::pow(headroom * target / (sf * dt[e]), 2);
-      const double m = (factor - 1) * block.density[e] * block.volume0[e];
-      block.density[e] *= factor;
-      added += m;
+    const double cap = (1 + max_added_ratio) * block.material->density();
+    DynamicScalingResult r;
+    for (std::size_t e = block.range_begin; e < std::min(block.range_end, block.n); ++e) {
+      // Below the target (eroded: 1e300); at the cap: left to its step.
+      if (!(sf * dt[e] < target)) {
+        r.at_cap += block.density[e] >= cap ? 1 : 0;
+        continue;
+      }
+      if (block.density[e] >= cap) {
+        ++r.held_at_cap, ++r.at_cap;
+        continue;
+      }
+      const double rho =
+          std::min(block.density[e] * std::pow(headroom * target / (sf * dt[e]), 2), cap);
+      const double m = (rho - block.density[e]) * block.volume0[e];
+      block.density[e] = rho;
+      r.added_mass += m;
+      ++r.scaled;
+      r.at_cap += rho >= cap ? 1 : 0;
       for (int I = 0; I < 8; ++I) {
         const auto node = static_cast<std::size_t>(block.conn[I * block.n + e]);
         for (int c = 0; c < 3; ++c) dm[3 * node + c] += m / 8.0;
       }
     }
-    return added;
+    return r;
   }
   StableStep stable_step(const double* x) const override { return hex8_stable_step(block, x); }
   void internal_forces(const ElementCycleState& s, double* f, ElementEnergyIncrement& energy,

@@ -34,6 +34,7 @@ TEST(DynamicMassScaling, CrushedElementKeepsTheTargetStepWithTheMassItNeeds) {
   model.time.erosion_step_ratio = 0.5;
   model.time.mass_scaling_dt = dt0 * (1 + 1e-12);  // nothing to scale at the start
   model.time.mass_scaling_dynamic = true;
+  model.time.mass_scaling_max_ratio = 1e3;  // out of reach (the cap: the next test)
 
   fem::ExplicitSolver solver(model);
   ASSERT_TRUE(test::near_rel(solver.time_step(), dt0, 1e-9));
@@ -68,6 +69,51 @@ TEST(DynamicMassScaling, CrushedElementKeepsTheTargetStepWithTheMassItNeeds) {
     for (std::size_t i = 0; i < model.mesh.n_nodes(); ++i) nodal += M[3 * i];
   }
   EXPECT_TRUE(test::near_rel(nodal, 2 * kRho * kH * kH * kH + added, 1e-12));
+
+  const auto& en = solver.energy();
+  EXPECT_LT(std::abs(en.total() - en.initial_total - en.external_work), 2e-5 * en.internal)
+      << "internal " << en.internal;
+}
+
+// The cap on added mass (time.mass_scaling_max_ratio = 3): the lower cube is scaled as above
+// until its density reaches 4 rho (when (1.05 h / h_A)^2 passes 4, h_A < 0.525 h); from there it
+// keeps 4 rho and its own step, dt0 (h_A / h) sqrt(4), which falls with the crush: at 30 % of
+// its height 0.6 dt0 (the erosion ratio 0.2 below it, nothing eroded). Reported as one capped
+// hexahedron; the balance stays closed. (The upper cube, launched by the middle plane, dips
+// below the target once and gets its 5 % headroom: 1.05^2 rho.)
+TEST(DynamicMassScaling, ElementAtTheCapKeepsItsMassAndItsOwnStep) {
+  fem::Model model;
+  test::add_crushed_column(model, kH, kRho, kE, kNu, kV);
+  const double c = std::sqrt(kE / (1 - 2 * kNu) / kRho);
+  const double sf = 0.9, dt0 = sf * kH / c;
+  model.time.safety_factor = sf;
+  model.time.end_time = 0.7 * kH / kV;
+  model.time.erosion_step_ratio = 0.2;
+  model.time.mass_scaling_dt = dt0 * (1 + 1e-12);
+  model.time.mass_scaling_dynamic = true;
+  model.time.mass_scaling_max_ratio = 3.0;
+
+  fem::ExplicitSolver solver(model);
+  while (solver.time() < model.time.end_time) solver.step();
+  EXPECT_TRUE(solver.erosions().empty()) << solver.erosions().size() << " eroded";
+  EXPECT_EQ(solver.mass_scaling_capped(), 1);
+
+  const auto& b = solver.blocks<fem::Hex8Block>().at(0);
+  const double h_a = kH - kV * solver.time();
+  double lower_density = 0, upper_density = 0;
+  for (std::size_t e = 0; e < b.n; ++e) {
+    double z = 0;
+    for (int I = 0; I < 8; ++I)
+      z += model.mesh.coords[3 * static_cast<std::size_t>(b.conn[I * b.n + e]) + 2] / 8;
+    (z < kH ? lower_density : upper_density) = b.density[e];
+  }
+  EXPECT_TRUE(test::near_rel(lower_density, 4 * kRho, 1e-12)) << lower_density / kRho;
+  EXPECT_LT(upper_density, 1.11 * kRho);
+  // Its own step at the end: 2 dt0 h_A / h, within one cycle's shrinking (0.5 %).
+  EXPECT_TRUE(test::near_rel(solver.time_step(), 2 * dt0 * h_a / kH, 5e-3))
+      << solver.time_step() / dt0 << " dt0, expected " << 2 * h_a / kH;
+  EXPECT_TRUE(test::near_rel(solver.part_masses()[0].added_mass,
+                             (lower_density + upper_density - 2 * kRho) * kH * kH * kH, 1e-12));
 
   const auto& en = solver.energy();
   EXPECT_LT(std::abs(en.total() - en.initial_total - en.external_work), 2e-5 * en.internal)

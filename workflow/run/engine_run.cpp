@@ -648,8 +648,12 @@ void log_end(const Run& r, const fem::ExplicitSolver& solver) {
         1e9 * r.loop_cpu / loop_ec);
   }
   if (solver.model().time.mass_scaling_dynamic) {
-    r.log->info("dynamic mass scaling: mass added in {} cycles (hexahedra below {:.4g} s)",
-                solver.mass_scaling_events(), solver.model().time.mass_scaling_dt);
+    r.log->info(
+        "dynamic mass scaling: mass added in {} cycles (hexahedra below {:.4g} s); {} hexahedra "
+        "reached the cap of {:.4g} times their physical mass added (time.mass_scaling_max_ratio), "
+        "their step their own from there",
+        solver.mass_scaling_events(), solver.model().time.mass_scaling_dt,
+        solver.mass_scaling_capped(), solver.model().time.mass_scaling_max_ratio);
     log_part_masses(solver, *r.log);
   }
   if (solver.domain() && solver.contact_halo_builds() > 0)

@@ -92,6 +92,7 @@ void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json
     }
     summary["added_mass_ratio"] = ratio;
     summary["mass_scaling_events"] = solver.mass_scaling_events();
+    summary["mass_scaling_capped_elements"] = solver.mass_scaling_capped();
   }
   summary["kinetic_energy_J"] = en.kinetic;
   summary["internal_energy_J"] = en.internal;
