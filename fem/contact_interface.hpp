@@ -39,6 +39,10 @@ class ContactAlgorithm {
   /// f_contact [3*n_nodes]. Forces between deformable bodies must sum to zero.
   virtual void add_forces(const double* x, const double* v, const double* mass, double dt,
                           double* f_contact) = 0;
+  /// Before add_forces: a running bound on how far any node this contact reads has moved since
+  /// the solver started or resumed (m, non-decreasing; not called: none). A contact may skip
+  /// work whose outcome the nodes cannot have changed by moving that much since it last did it.
+  virtual void set_node_travel(double travel) { (void)travel; }
   /// Energy dissipated by friction (and failed ties) so far, J; part of the contact energy.
   virtual double friction_dissipation() const = 0;
   /// Resultants per reported pair, valid after add_forces.

@@ -73,6 +73,9 @@ struct TimeControl {
   // eroded at erosion_step_ratio): a folding element would otherwise take mass without bound.
   bool mass_scaling_dynamic = false;
   double mass_scaling_max_ratio = 10.0;
+  // An element at that cap whose step still falls below mass_scaling_dt is eroded at once
+  // (mass scaling cannot hold it any more), so the run keeps its step.
+  bool mass_scaling_erode_at_cap = false;
   double history_interval = 0;      // 0: 200 rows over the run
   double frame_interval = 0;        // 0: 20 frames over the run
   std::int64_t max_cycles = 0;      // 0: unlimited

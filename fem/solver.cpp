@@ -305,14 +305,17 @@ void ExplicitSolver::erode_and_choose_step(const CycleArrays& a, Cycle& c) {
   // cycles, are looked for every kFoldCheckInterval cycles. The forces of this cycle stand.
   // A failed material point (damage laws) is eroded in the cycle it fails.
   const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
-  if (dt_erode > 0 || material_failure_) {
+  // With time.mass_scaling_erode_at_cap, an element at the mass cap is eroded once its step is
+  // below the target: looked for whenever the step is.
+  const double cap_dt = model_.time.mass_scaling_erode_at_cap ? model_.time.mass_scaling_dt : 0.0;
+  if (dt_erode > 0 || cap_dt > 0 || material_failure_) {
     bool check_steps = false;
-    if (dt_erode > 0) {
+    if (dt_erode > 0 || cap_dt > 0) {
       StableStep erodible;
       for (std::size_t k = 0; k < groups_.size(); ++k)
         if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
-      check_steps =
-          model_.time.safety_factor * erodible.dt < dt_erode || cycle_ % kFoldCheckInterval == 0;
+      const double sf_dt = model_.time.safety_factor * erodible.dt;
+      check_steps = sf_dt < dt_erode || sf_dt < cap_dt || cycle_ % kFoldCheckInterval == 0;
     }
     erode(a.x, a.v, dt_erode, check_steps, c.blow_up);
   }
@@ -342,6 +345,7 @@ void ExplicitSolver::contact_forces(const CycleArrays& a, Cycle& c) {
     for (std::size_t q = 0; q < model_.contacts.size(); ++q) {
       const auto t0 = Clock::now();
       auto& k = model_.contacts[q];
+      k->set_node_travel(domain_ ? travel_all_ranks_ : node_travel_);
       k->add_forces(a.x, a.v, a.m, dt_c, a.fc);
       c.dt_new = std::min(c.dt_new, k->stable_step_limit());
       contact_seconds_[q] += seconds_since(t0);
@@ -552,6 +556,7 @@ void ExplicitSolver::sum_over_ranks(Cycle& c) {
   for (unsigned b = 0; (kRequestMask >> b) != 0; ++b)
     if (r[at_requests + b] > 0) requests_all_ranks_ |= 1u << b;
   halo_travel_ += r.back();
+  travel_all_ranks_ += r.back();
   c.ext_old = r[0], c.ext_new = r[1], c.damp_old = r[2], c.damp_new = r[3], c.con_old = r[4],
   c.con_new = r[5], c.ke = r[6];
   energy_.internal = booked0[0] + r[11] + r[7];

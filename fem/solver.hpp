@@ -52,7 +52,7 @@ class BlockList {
 
 /// One element removed by erosion.
 struct ErosionEvent {
-  enum class Cause { StableStep, InvertedCorner, MaterialFailure };
+  enum class Cause { StableStep, InvertedCorner, MaterialFailure, MassCap };
   Cause cause = Cause::StableStep;
   double time = 0;
   std::int64_t cycle = 0;
@@ -95,9 +95,12 @@ class ExplicitSolver {
   const EnergyBalance& energy() const { return energy_; }
   const StableStep& controlling_element() const { return step_; }
   const std::vector<PartMassReport>& part_masses() const { return part_mass_; }
-  /// Whether elements may be eroded: time.erosion_step_ratio set, or a material that fails
-  /// elements (a damage law).
-  bool erosion_enabled() const { return model_.time.erosion_step_ratio > 0 || material_failure_; }
+  /// Whether elements may be eroded: time.erosion_step_ratio or time.mass_scaling_erode_at_cap
+  /// set, or a material that fails elements (a damage law).
+  bool erosion_enabled() const {
+    return model_.time.erosion_step_ratio > 0 || model_.time.mass_scaling_erode_at_cap ||
+           material_failure_;
+  }
   /// Elements eroded so far (time.erosion_step_ratio, material failure), in order.
   const std::vector<ErosionEvent>& erosions() const { return erosions_; }
   /// Nodes left with no element by erosion so far: they are held where they were, out of every
@@ -309,6 +312,9 @@ class ExplicitSolver {
   // the ranks each cycle, the same on all), the last exact check of it, and the builds so far.
   std::vector<double> halo_x_;
   double halo_travel_ = 0, halo_checked_d_ = 0, halo_travel_checked_ = 0, node_travel_sent_ = 0;
+  // The same bound summed over the ranks since this process started, never reset (the contacts'
+  // displacement checks read it: every node they read moved at most that far).
+  double travel_all_ranks_ = 0;
   bool halo_due_ = false;  // after a resume: rebuild the last build's halo at the next cycle
   std::int64_t halo_builds_ = 0;
   void refresh_contact_halo(double* x, double* v);

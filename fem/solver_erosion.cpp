@@ -45,6 +45,10 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
 void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bool check_steps,
                            const std::string& blow_up) {
   const double sf = model_.time.safety_factor;
+  // Dynamic mass scaling with time.mass_scaling_erode_at_cap: an element at the cap below the
+  // target step cannot be held by mass any more.
+  const double cap_dt = model_.time.mass_scaling_erode_at_cap ? model_.time.mass_scaling_dt : 0.0;
+  const double cap_ratio = model_.time.mass_scaling_max_ratio;
   std::vector<std::int32_t> gone;  // mesh-wide element indices
   std::vector<std::int32_t> orphans;
   std::vector<std::size_t> failed;
@@ -68,20 +72,24 @@ void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bo
       const bool folded = check_steps && dt_erode > 0 && !(jacobian_scratch_[e] > 0);
       const bool too_small = check_steps && dt_erode > 0 && sf * dt < dt_erode;
       const bool broken = !material_failed.empty() && material_failed[e];
-      if (!too_small && !folded && !broken) {
+      const bool capped =
+          check_steps && !too_small && !folded && sf * dt < cap_dt && g.at_mass_cap(e, cap_ratio);
+      if (!too_small && !folded && !broken && !capped) {
         if (dt < left.dt) left = {dt, g.user_id(e), g.kind()};
         continue;
       }
       using Cause = ErosionEvent::Cause;
-      const ErosionEvent ev{
-          broken ? Cause::MaterialFailure : (folded ? Cause::InvertedCorner : Cause::StableStep),
-          t_,
-          cycle_,
-          g.user_id(e),
-          g.kind(),
-          g.part(),
-          sf * dt,
-          centroid(g.conn(), g.size(), e, nn, x)};
+      const ErosionEvent ev{broken   ? Cause::MaterialFailure
+                            : folded ? Cause::InvertedCorner
+                            : capped ? Cause::MassCap
+                                     : Cause::StableStep,
+                            t_,
+                            cycle_,
+                            g.user_id(e),
+                            g.kind(),
+                            g.part(),
+                            sf * dt,
+                            centroid(g.conn(), g.size(), e, nn, x)};
       ErodedForce& ef = eroded_forces_.emplace_back();
       ef.n_nodes = nn;
       for (int I = 0; I < nn; ++I) {

@@ -2,6 +2,7 @@
 // calibrate, compare.
 // Exit codes: 0 success, 1 other error (incl. an interrupted run), 2 bad input, 3 numerical
 // failure.
+#include <signal.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -40,29 +41,6 @@
 namespace wf = ncfsim::workflow;
 
 namespace {
-
-// `ncfsim run ... --np N` outside a launcher: starts N ranks of this same executable with the
-// launcher CMake found, the same arguments less --np (docs/cli.md).
-int relaunch_with_mpiexec(int ranks, int argc, char** argv) {
-  std::vector<std::string> args = wf::mpi_launch_command(ranks);
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--np") {
-      ++i;
-      continue;
-    }
-    if (a.rfind("--np=", 0) == 0) continue;
-    args.push_back(a);
-  }
-  std::vector<char*> cargs;
-  for (auto& a : args) cargs.push_back(a.data());
-  cargs.push_back(nullptr);
-  std::fflush(nullptr);
-  execvp(cargs[0], cargs.data());
-  std::fprintf(stderr, "ncfsim: bad input: --np %d: cannot start the MPI launcher '%s': %s\n",
-               ranks, args[0].c_str(), std::strerror(errno));
-  return wf::kBadInput;
-}
 
 int bad_input(const std::exception& e) {
   std::fprintf(stderr, "ncfsim: bad input: %s\n", e.what());
@@ -129,12 +107,50 @@ void add_run(CLI::App& app, RunArgs& a) {
           "SECONDS"));
 }
 
+// `ncfsim run ... --np N` outside a launcher: starts N ranks of this same executable with the
+// launcher CMake found, the same arguments less --np (docs/cli.md), and waits for them: one
+// Ctrl-C (or SIGTERM) is passed on to the ranks, which checkpoint at one cycle; if this process
+// is killed, so is the launcher. A rank lost (killed, out of memory, crashed) ends the job
+// without the run's status: this process writes it (failed, naming the rank) into summary.json.
+int relaunch_with_mpiexec(const RunArgs& a, int argc, char** argv) {
+  std::vector<std::string> args = wf::mpi_launch_command(a.ranks);
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--np") {
+      ++i;
+      continue;
+    }
+    if (arg.rfind("--np=", 0) == 0) continue;
+    args.push_back(arg);
+  }
+  wf::LauncherExit ex;
+  try {
+    ex = wf::run_launcher(args, wf::launcher_environment(), SIGKILL, wf::StopRequest::requested);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ncfsim: bad input: --np %d: %s\n", a.ranks, e.what());
+    return wf::kBadInput;
+  }
+  if (ex.exit_code == 0) return 0;
+  if (!ex.lost_rank.empty())
+    std::fprintf(stderr, "ncfsim: MPI %s was lost; the launcher ended the other ranks\n",
+                 ex.lost_rank.c_str());
+  try {
+    const std::filesystem::path dir = wf::run_output_folder(a.case_file, a.overrides, a.out_dir);
+    if (!dir.empty() && wf::record_lost_rank(dir, ex.lost_rank, ex.exit_code, a.ranks))
+      std::fprintf(stderr, "ncfsim: %s/summary.json: status failed (it said running)\n",
+                   dir.string().c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ncfsim: the run's status could not be checked: %s\n", e.what());
+  }
+  return ex.exit_code;
+}
+
 // [case] kind -> its stage (workflow/stages/stage_registry.hpp).
 int run_run(const RunArgs& a, wf::Verbosity verbosity, int argc, char** argv) {
   // A workflow is not relaunched: it runs its engine stages on --np ranks each.
   if (a.ranks > 1 && !wf::started_by_mpi_launcher() &&
-      wf::case_kind(a.case_file, a.overrides) != "workflow")
-    return relaunch_with_mpiexec(a.ranks, argc, argv);
+      !wf::find_stage(wf::case_kind(a.case_file, a.overrides), a.case_file).holds_stages)
+    return relaunch_with_mpiexec(a, argc, argv);
   wf::StageCall call;
   call.case_file = a.case_file;
   call.overrides = a.overrides;
@@ -234,7 +250,8 @@ int run_report(const std::string& folder) {
   require_output_folder(folder);
   const auto lock = wf::FolderLock::acquire(folder, "report");
   const auto js = wf::read_json_file(std::filesystem::path(folder) / "summary.json");
-  if (js.is_object() && js.value("stage", "") == "workflow")
+  const wf::Stage* stage = js.is_object() ? wf::stage_of_kind(js.value("stage", "")) : nullptr;
+  if (stage && stage->holds_stages)
     wf::write_workflow_report(folder);
   else
     wf::write_report(folder);

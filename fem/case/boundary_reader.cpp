@@ -123,6 +123,11 @@ void read_time(CaseReadContext& ctx) {
             "dynamic mass scaling needs its target step: set time.mass_scaling_dt > 0");
   time.mass_scaling_max_ratio =
       tc.number("mass_scaling_max_ratio", 10.0, Range::open_closed(0, 1e6));
+  time.mass_scaling_erode_at_cap = tc.boolean("mass_scaling_erode_at_cap", false);
+  if (time.mass_scaling_erode_at_cap && !time.mass_scaling_dynamic)
+    tc.fail("mass_scaling_erode_at_cap",
+            "erodes elements at the cap of dynamic mass scaling: set time.mass_scaling_dynamic = "
+            "true");
   time.history_interval = tc.number("history_interval", time.end_time / 200, Range::positive());
   time.frame_interval = tc.number("frame_interval", time.end_time / 20, Range::positive());
   time.max_cycles = tc.integer("max_cycles", 0, 0, std::int64_t{1} << 50);

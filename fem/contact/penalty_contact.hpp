@@ -63,6 +63,8 @@ struct PenaltyContactStats {
   std::int32_t max_penetration_node = -1;  // mesh node where it occurs
   double sort_seconds = 0;                 // time in bucket sorts (broad phase)
   double check_seconds = 0;                // time in the displacement checks
+  std::int64_t n_checks = 0;  // displacement checks made since this process started (the others
+                              // were skipped on the solver's travel bound: set_node_travel)
   double narrow_seconds = 0;  // time in the narrow phase (incl. segment frames) and forces
   // Since the start (or the resume) of the run: contacts summed over cycles, and how many of them
   // moved to another segment than the cycle before (a vibrating interface near facet corners
@@ -110,6 +112,7 @@ class PenaltyContact final : public ContactAlgorithm {
   }
   std::int64_t n_broad_phase_searches() const override { return stats_.n_sorts; }
   std::string cost_details() const override;
+  void set_node_travel(double travel) override { travel_ = travel; }
 
  private:
   void sort_segments(const double* x);                      // broad phase at positions x
@@ -117,16 +120,30 @@ class PenaltyContact final : public ContactAlgorithm {
   /// Frames at x of the n <= kFrameLanes segments seg[0..n) in SIMD lanes (the rest padded).
   void block_frames(const double* x, const std::int32_t* seg, std::size_t n,
                     SegmentFrameBlock& fb) const;
+  /// The outer faces adjacent to segment `seg` (adj[4] of it), as closer_adjacent_face reads
+  /// them: made at the first hit on the segment in a cycle's narrow phase and kept for its other
+  /// candidates (they are listed together), each frame once a node faces that face. The same
+  /// arithmetic as making them for each hit: the same results bit for bit.
+  struct AdjacentFaces {
+    std::int32_t seg = -1;  // the segment they are adjacent to (-1: none yet)
+    struct Face {
+      bool off = true;  // not a face of the surface (yet, or any more)
+      bool framed = false;
+      double m[3] = {}, m_len = 0;  // d1 x d2 and its length
+      SegmentFrame frame;
+    } face[4];
+  };
   /// Closest-feature test of a contact of penetration pen on a segment, against the outer faces
-  /// adjacent to it in the same hexahedron (adj[4], -1 padded) that are opposed to one of the
-  /// node's nf facets (fn[nf][3]). True (not the contact) when, for such a face, the node at p
-  /// is neither behind its plane by at least pen (then the segment is the nearest way out) nor
-  /// holding this contact from the last cycle (in_contact) with pen <= edge_tolerance * the
-  /// hexahedron's thickness normal to that face (a node sliding past the convex edge into the
-  /// segment's edge-tolerance band keeps its contact; one arriving there from the side, or deep
-  /// behind the segment's plane but outside the body, gets none).
-  bool closer_adjacent_face(const double* x, const std::int32_t* adj, const double* fn, int nf,
-                            double px, double py, double pz, double pen, bool in_contact);
+  /// adjacent to it in the same hexahedron (adj[4], -1 padded; `faces` made of them) that are
+  /// opposed to one of the node's nf facets (fn[nf][3]). True (not the contact) when, for such a
+  /// face, the node at p is neither behind its plane by at least pen (then the segment is the
+  /// nearest way out) nor holding this contact from the last cycle (in_contact) with pen <=
+  /// edge_tolerance * the hexahedron's thickness normal to that face (a node sliding past the
+  /// convex edge into the segment's edge-tolerance band keeps its contact; one arriving there from
+  /// the side, or deep behind the segment's plane but outside the body, gets none).
+  bool closer_adjacent_face(const double* x, std::int32_t seg, const std::int32_t* adj,
+                            AdjacentFaces& faces, const double* fn, int nf, double px, double py,
+                            double pz, double pen, bool in_contact);
 
   PenaltyContactConfig cfg_;
   ContactSurface surf_;
@@ -220,6 +237,9 @@ class PenaltyContact final : public ContactAlgorithm {
   std::vector<std::int32_t> node_readable_;  // surface nodes this rank reads
   std::vector<std::size_t> frame_blocks_;    // frame blocks holding a segment it reads
   bool resort_ = false;  // the surface changed: sort before the next cycle
+  // The solver's bound on the nodes' travel (set_node_travel; < 0: none), and at the last
+  // displacement check that bound and the largest displacement since the sort it measured.
+  double travel_ = -1, travel_checked_ = -1, checked_d_ = 0;
   BucketGrid grid_;
 
   ContactBatch batch_;          // active contacts on their way through the force kernel

@@ -74,6 +74,12 @@ class ElementGroup {
     (void)x, (void)target_dt, (void)safety, (void)headroom, (void)max_added_ratio, (void)dm;
     return {};
   }
+  /// Whether element e's density has reached (1 + max_added_ratio) times its material's (the cap
+  /// of dynamic mass scaling). Kinds that do not scale during a run: never.
+  virtual bool at_mass_cap(std::size_t e, double max_added_ratio) const {
+    (void)e, (void)max_added_ratio;
+    return false;
+  }
   /// Stable step of the group's controlling element at positions x.
   virtual StableStep stable_step(const double* x) const = 0;
   /// Internal forces subtracted from f [3*n_nodes]; energy increments accumulated, step lowered to

@@ -67,6 +67,9 @@ class Hex8Group final : public ElementGroup {
     }
     return r;
   }
+  bool at_mass_cap(std::size_t e, double max_added_ratio) const override {
+    return block.density[e] >= (1 + max_added_ratio) * block.material->density();
+  }
   StableStep stable_step(const double* x) const override { return hex8_stable_step(block, x); }
   void internal_forces(const ElementCycleState& s, double* f, ElementEnergyIncrement& energy,
                        StableStep& step) override {

@@ -186,3 +186,67 @@ TEST(ContactStack, PliesMeshedAlikeKeepTheirSegmentsWhilePressed) {
   EXPECT_LT(rate, 1e-3);
   EXPECT_LT(solver.energy().error(), 0.01);
 }
+
+namespace {
+
+// The penalty contact as it was before the solver's travel bound: every call of
+// set_node_travel is dropped, so the displacement check runs every cycle.
+class WithoutTravelBound final : public fem::ContactAlgorithm {
+ public:
+  explicit WithoutTravelBound(std::unique_ptr<fem::ContactAlgorithm> c) : c_(std::move(c)) {}
+  const std::string& name() const override { return c_->name(); }
+  void initialise(const fem::ContactSetup& setup) override { c_->initialise(setup); }
+  void add_forces(const double* x, const double* v, const double* m, double dt,
+                  double* f) override {
+    c_->add_forces(x, v, m, dt, f);
+  }
+  double friction_dissipation() const override { return c_->friction_dissipation(); }
+  std::vector<fem::ContactResultant> resultants() const override { return c_->resultants(); }
+  double stable_step_limit() const override { return c_->stable_step_limit(); }
+  std::int64_t active_contacts() const override { return c_->active_contacts(); }
+  double max_penetration() const override { return c_->max_penetration(); }
+  void save_state(fem::CheckpointWriter& w) const override { c_->save_state(w); }
+  void load_state(fem::CheckpointReader& r) override { c_->load_state(r); }
+
+ private:
+  std::unique_ptr<fem::ContactAlgorithm> c_;
+};
+
+}  // namespace
+
+// The displacement check of the broad phase skipped while the solver's bound on the nodes'
+// travel (3.5 dt v_max summed over the cycles) cannot have taken a node to the search margin:
+// the stack of six pressed and sheared strips gives the same positions, velocities and contact
+// energy to the last bit as with the check made every cycle, with the same sorts, and the check
+// is made in fewer than half of the cycles.
+TEST(ContactStack, TravelBoundSkipsDisplacementChecksAndChangesNothing) {
+  std::vector<double> x[2], v[2];
+  std::int64_t sorts[2] = {}, checks[2] = {}, cycles[2] = {};
+  double friction[2] = {};
+  for (int run = 0; run < 2; ++run) {
+    Stack s;
+    build_stack(s, 6, 8, 2, 20e-3, 5e-3, true, 0.1, true);
+    s.model.time.end_time = 2.5e-3;
+    if (run == 1) {
+      auto c = std::move(s.model.contacts.back());
+      s.model.contacts.back() = std::make_unique<WithoutTravelBound>(std::move(c));
+    }
+    fem::ExplicitSolver solver(s.model);
+    while (solver.time() < s.model.time.end_time) solver.step();
+    auto X = solver.x.view();
+    auto V = solver.v.view();
+    x[run].assign(X.data(), X.data() + 3 * s.model.mesh.n_nodes());
+    v[run].assign(V.data(), V.data() + 3 * s.model.mesh.n_nodes());
+    sorts[run] = s.contact->stats().n_sorts;
+    checks[run] = s.contact->stats().n_checks;
+    cycles[run] = s.contact->stats().n_cycles;
+    friction[run] = s.contact->friction_dissipation();
+  }
+  EXPECT_TRUE(x[0] == x[1]) << "positions differ";
+  EXPECT_TRUE(v[0] == v[1]) << "velocities differ";
+  EXPECT_EQ(friction[0], friction[1]);
+  EXPECT_EQ(sorts[0], sorts[1]);
+  EXPECT_GT(sorts[0], 1) << "the strips should have slid far enough to be sorted again";
+  EXPECT_EQ(checks[1], cycles[1]) << "without the bound every cycle checks";
+  EXPECT_LT(2 * checks[0], cycles[0]) << checks[0] << " checks in " << cycles[0] << " cycles";
+}

@@ -22,19 +22,26 @@ using namespace ncfsim;
 
 namespace {
 constexpr double kH = 0.01, kRho = 1000, kE = 1e6, kNu = 0.3, kV = 0.05;
-}  // namespace
 
-TEST(DynamicMassScaling, CrushedElementKeepsTheTargetStepWithTheMassItNeeds) {
-  fem::Model model;
+// The column with dynamic mass scaling to its initial step dt0 (returned), crushed to 30 % of
+// the lower cube's height, each hexahedron's added mass capped at max_added_ratio.
+double scaled_column(fem::Model& model, double max_added_ratio) {
   test::add_crushed_column(model, kH, kRho, kE, kNu, kV);
   const double c = std::sqrt(kE / (1 - 2 * kNu) / kRho);  // the step's modulus 3K
   const double sf = 0.9, dt0 = sf * kH / c;
   model.time.safety_factor = sf;
-  model.time.end_time = 0.7 * kH / kV;  // the lower cube at 30 % of its height
-  model.time.erosion_step_ratio = 0.5;
+  model.time.end_time = 0.7 * kH / kV;
   model.time.mass_scaling_dt = dt0 * (1 + 1e-12);  // nothing to scale at the start
   model.time.mass_scaling_dynamic = true;
-  model.time.mass_scaling_max_ratio = 1e3;  // out of reach (the cap: the next test)
+  model.time.mass_scaling_max_ratio = max_added_ratio;
+  return dt0;
+}
+}  // namespace
+
+TEST(DynamicMassScaling, CrushedElementKeepsTheTargetStepWithTheMassItNeeds) {
+  fem::Model model;
+  const double dt0 = scaled_column(model, 1e3);  // the cap out of reach (the next tests)
+  model.time.erosion_step_ratio = 0.5;
 
   fem::ExplicitSolver solver(model);
   ASSERT_TRUE(test::near_rel(solver.time_step(), dt0, 1e-9));
@@ -83,15 +90,8 @@ TEST(DynamicMassScaling, CrushedElementKeepsTheTargetStepWithTheMassItNeeds) {
 // below the target once and gets its 5 % headroom: 1.05^2 rho.)
 TEST(DynamicMassScaling, ElementAtTheCapKeepsItsMassAndItsOwnStep) {
   fem::Model model;
-  test::add_crushed_column(model, kH, kRho, kE, kNu, kV);
-  const double c = std::sqrt(kE / (1 - 2 * kNu) / kRho);
-  const double sf = 0.9, dt0 = sf * kH / c;
-  model.time.safety_factor = sf;
-  model.time.end_time = 0.7 * kH / kV;
+  const double dt0 = scaled_column(model, 3.0);
   model.time.erosion_step_ratio = 0.2;
-  model.time.mass_scaling_dt = dt0 * (1 + 1e-12);
-  model.time.mass_scaling_dynamic = true;
-  model.time.mass_scaling_max_ratio = 3.0;
 
   fem::ExplicitSolver solver(model);
   while (solver.time() < model.time.end_time) solver.step();
@@ -118,4 +118,27 @@ TEST(DynamicMassScaling, ElementAtTheCapKeepsItsMassAndItsOwnStep) {
   const auto& en = solver.energy();
   EXPECT_LT(std::abs(en.total() - en.initial_total - en.external_work), 2e-5 * en.internal)
       << "internal " << en.internal;
+}
+
+// time.mass_scaling_erode_at_cap: the lower cube reaches the cap (4 rho) at h_A = 0.525 h with
+// 5 % headroom, its own step 2 dt0 h_A / h then falls below the target at h_A = h / 2, and there
+// it is eroded (cause MassCap), at t = h / (2 v) within a cycle; the step never falls more than a
+// cycle's shrinking below the target.
+TEST(DynamicMassScaling, ElementAtTheCapIsErodedWhenItsStepFallsBelowTheTargetIfAsked) {
+  fem::Model model;
+  const double dt0 = scaled_column(model, 3.0);
+  model.time.mass_scaling_erode_at_cap = true;
+
+  fem::ExplicitSolver solver(model);
+  double smallest = 1e300;
+  while (solver.time() < model.time.end_time) {
+    solver.step();
+    smallest = std::min(smallest, solver.time_step());
+  }
+  ASSERT_EQ(solver.erosions().size(), 1u);
+  const auto& ev = solver.erosions().front();
+  EXPECT_EQ(ev.cause, fem::ErosionEvent::Cause::MassCap);
+  EXPECT_LT(ev.centroid.z, kH) << "the lower cube";
+  EXPECT_NEAR(ev.time, 0.5 * kH / kV, 2 * dt0) << "h_A = h / 2";
+  EXPECT_GT(smallest, 0.995 * dt0);
 }

@@ -180,7 +180,8 @@ TEST(MpiRuns, WhatCannotBeSplitIsRefused) {
               {kMpiexec, "-n", "2"});
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("runs on one MPI rank"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("runs its engine stages on N ranks"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("runs its engine and crush stages on N ranks"), std::string::npos)
+      << r.output;
   for (const char* d : {"mpi_np0", "mpi_too_many", "mpi_shells", "mpi_workflow"})
     fs::remove_all(fresh_dir(d));
 }

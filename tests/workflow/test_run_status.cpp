@@ -17,6 +17,7 @@
 
 #include "tests/workflow/cli_test_support.hpp"
 #include "tests/workflow/mpi_test_support.hpp"
+#include "workflow/run/mpi_launch.hpp"
 
 namespace ncfsim::test {
 namespace {
@@ -182,6 +183,63 @@ TEST(CliRunFolder, RunThatLostAnMpiRankIsFoundKilledByStatus) {
   for (const pid_t r : ranks) kill(r, SIGKILL);  // whatever the launcher left
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   expect_found_killed(out, true);
+  fs::remove(log);
+}
+
+// Open MPI's report of a rank lost to a signal (as mpiexec 4.1 prints it), and of ranks that
+// only exited non-zero (not a lost rank: the ranks say why they stop).
+TEST(CliRunFolder, LauncherReportOfALostRankIsRead) {
+  const std::string lost =
+      "-----\nmpiexec noticed that process rank 1 with PID 0 on node vm exited on signal 9 "
+      "(Killed).\n-----\n";
+  EXPECT_EQ(workflow::lost_rank_of(lost), "rank 1 (node vm): signal 9 (Killed)");
+  const std::string exited =
+      "mpiexec detected that one or more processes exited with non-zero status, thus causing\n"
+      "the job to be terminated. The first process to do so was:\n\n  Process name: "
+      "[[269,1],0]\n  Exit code:    3\n";
+  EXPECT_EQ(workflow::lost_rank_of(exited), "");
+}
+
+// `ncfsim run --np 2` waits for its launcher: a rank lost (SIGKILL) ends the job without the
+// run's status, and the process the user started writes it: failed, naming the rank and the
+// signal (a raw mpiexec's run, above, is found killed by ncfsim status instead).
+TEST(CliRunFolder, RunOnTwoRanksThatLostOneSaysFailedNamingTheRank) {
+  if (!launcher_works()) GTEST_SKIP() << "no MPI launcher that starts here";
+  const fs::path out = fresh_dir("folder_np_lost_rank");
+  const fs::path log = out.string() + ".log";
+  std::vector<std::string> args = long_run(out, {"mesh.block[0].divisions=[80,2,2]"});
+  args.insert(args.end(), {"--np", "2"});
+  const pid_t pid = spawn(args, log);
+  ChildGuard guard{{pid}};
+  ASSERT_TRUE(wait_running(out)) << slurp(log);
+  // The ranks: the processes naming the folder that this one did not start (ncfsim, launcher)
+  // and whose command is ncfsim's (not the launcher's).
+  std::vector<pid_t> ranks;
+  for (int i = 0; i < 100 && ranks.size() < 2; ++i) {
+    ranks.clear();
+    for (const pid_t p : processes_naming(out, pid)) {
+      std::ifstream in("/proc/" + std::to_string(p) + "/cmdline", std::ios::binary);
+      std::string first;
+      std::getline(in, first, '\0');
+      if (first == kExe.string()) ranks.push_back(p);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(ranks.size(), 2u) << slurp(log);
+  guard.pids.insert(guard.pids.end(), ranks.begin(), ranks.end());
+  kill(std::max(ranks[0], ranks[1]), SIGKILL);
+  EXPECT_NE(wait_code_within(pid, 120), 0) << slurp(log);
+  const auto s = summary(out);
+  EXPECT_EQ(s["status"], "failed") << slurp(log);
+  const std::string error = s.value("error", "");
+  EXPECT_NE(error.find("MPI rank "), std::string::npos) << error;
+  EXPECT_NE(error.find("signal 9"), std::string::npos) << error;
+  EXPECT_NE(slurp(log).find("was lost"), std::string::npos) << slurp(log);
+  // Open MPI's own banners about the job's end are not passed on.
+  EXPECT_EQ(slurp(log).find("Primary job"), std::string::npos) << slurp(log);
+  const auto st = run_cli({"status", out.string()});
+  EXPECT_NE(st.output.find("failed"), std::string::npos) << st.output;
+  EXPECT_NE(st.output.find("was lost"), std::string::npos) << st.output;
   fs::remove(log);
 }
 

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 
 #include "fem/errors.hpp"
 #include "workflow/output/folder_lock.hpp"
@@ -18,6 +20,27 @@ using nlohmann::json;
 std::string number_of(const json& s, const char* key) {
   return s.contains(key) && s[key].is_number() ? fmt::format("{:.4g}", s[key].get<double>())
                                                : std::string("?");
+}
+
+enum class Rewrite { written, not_running, started };
+
+// A summary that says running while nobody holds the folder: rewritten with `status` and
+// `error` under the folder's lock, so that a run starting now does not see a half-changed
+// folder.
+Rewrite rewrite_unfinished(const fs::path& dir, const std::string& status,
+                           const std::string& error) {
+  std::unique_ptr<FolderLock> lock;
+  try {
+    lock = FolderLock::acquire(dir, "status");
+  } catch (const InputError&) {
+    return Rewrite::started;
+  }
+  json s = read_json_file(dir / "summary.json");
+  if (!s.is_object() || s.value("status", "") != "running") return Rewrite::not_running;
+  s["status"] = status;
+  s["error"] = error;
+  write_file_atomically(dir / "summary.json", s.dump(2) + "\n");
+  return Rewrite::written;
 }
 
 FolderStatus status_of(const fs::path& dir) {
@@ -43,26 +66,17 @@ FolderStatus status_of(const fs::path& dir) {
                            h.is_object() ? h.value("since", "?") : "?");
       return f;
     }
-    // Nobody holds the folder: take it while the summary is rewritten, so that a run starting
-    // now does not see a half-changed folder.
-    std::unique_ptr<FolderLock> lock;
-    try {
-      lock = FolderLock::acquire(dir, "status");
-    } catch (const InputError&) {  // a run started meanwhile: it is running after all
+    const Rewrite r = rewrite_unfinished(
+        dir, "killed",
+        "the run ended without writing its status: its process was killed, or an MPI rank "
+        "was lost (found by ncfsim status: summary.json said running, no process held the "
+        "folder)");
+    if (r == Rewrite::started) {  // a run started meanwhile: it is running after all
       f.line = "running (a run started just now)";
       return f;
     }
+    if (r == Rewrite::written) f.status = "killed", f.rewritten = true;
     s = read_json_file(dir / "summary.json");
-    if (s.is_object() && s.value("status", "") == "running") {
-      f.status = "killed";
-      s["status"] = f.status;
-      s["error"] =
-          "the run ended without writing its status: its process was killed, or an MPI rank "
-          "was lost (found by ncfsim status: summary.json said running, no process held the "
-          "folder)";
-      write_file_atomically(dir / "summary.json", s.dump(2) + "\n");
-      f.rewritten = true;
-    }
   }
   f.line = f.status + where;
   if (f.rewritten)
@@ -89,6 +103,31 @@ std::vector<FolderStatus> folder_status(const fs::path& dir) {
   std::sort(stages.begin(), stages.end());
   for (const auto& p : stages) all.push_back(status_of(p));
   return all;
+}
+
+bool record_lost_rank(const fs::path& dir, const std::string& lost_rank, int launcher_exit,
+                      int ranks) {
+  // Only a job that lost a rank, or whose launcher was killed: a run that ended by itself
+  // (refused, bad input, a numerical failure) wrote its own status, and a summary that said
+  // running before it started is an older run's, for ncfsim status to find killed.
+  if (lost_rank.empty() && launcher_exit < 128) return false;
+  const json s = read_json_file(dir / "summary.json");
+  if (!s.is_object() || s.value("status", "") != "running") return false;
+  // The ranks the launcher ended may hold the folder a moment longer.
+  for (int i = 0; i < 100 && FolderLock::held(dir); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  if (FolderLock::held(dir)) return false;
+  const std::string error =
+      lost_rank.empty()
+          ? fmt::format(
+                "the run ended without writing its status: its MPI launcher exited with "
+                "{} ({} ranks; the launcher reported no rank lost)",
+                launcher_exit, ranks)
+          : fmt::format(
+                "MPI {} of {} was lost: the launcher ended the other ranks (exit {}) "
+                "before the run could write its status",
+                lost_rank, ranks, launcher_exit);
+  return rewrite_unfinished(dir, "failed", error) == Rewrite::written;
 }
 
 }  // namespace ncfsim::workflow

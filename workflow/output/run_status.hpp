@@ -23,4 +23,13 @@ struct FolderStatus {
 /// the folder holds no readable summary.json.
 std::vector<FolderStatus> folder_status(const std::filesystem::path& dir);
 
+/// After a run on `ranks` MPI ranks whose launcher reported `lost_rank` (lost_rank_of) or was
+/// killed (`launcher_exit` >= 128): where the run's summary.json still says running and no
+/// process holds the folder (waited for up to 5 s),
+/// the run ended without writing its status (a rank was lost, the launcher ended the others):
+/// summary.json becomes `failed`, its error naming the rank lost (lost_rank_of's text) or, if
+/// none was reported, the launcher's exit. True when it was rewritten.
+bool record_lost_rank(const std::filesystem::path& dir, const std::string& lost_rank,
+                      int launcher_exit, int ranks);
+
 }  // namespace ncfsim::workflow

@@ -453,9 +453,15 @@ void log_erosions(const fem::ExplicitSolver& s, MeasureList& measures, std::size
           ev.element, part, ev.time, ev.cycle, ev.centroid.x, ev.centroid.y, ev.centroid.z);
       continue;
     }
+    using Cause = fem::ErosionEvent::Cause;
     const std::string why =
-        ev.cause == fem::ErosionEvent::Cause::InvertedCorner
-            ? "a corner folded over (corner Jacobian <= 0)"
+        ev.cause == Cause::InvertedCorner ? "a corner folded over (corner Jacobian <= 0)"
+        : ev.cause == Cause::MassCap
+            ? fmt::format(
+                  "at the cap of dynamic mass scaling ({:g} times its mass added, "
+                  "time.mass_scaling_max_ratio) its step {:.3g} s fell below "
+                  "time.mass_scaling_dt = {:.3g} s (time.mass_scaling_erode_at_cap)",
+                  tc.mass_scaling_max_ratio, ev.step, tc.mass_scaling_dt)
             : fmt::format(
                   "its step {:.3g} s fell below time.erosion_step_ratio = {:g} of the "
                   "initial one",
@@ -623,6 +629,16 @@ void log_end(const Run& r, const fem::ExplicitSolver& solver) {
       en.time, en.kinetic, en.internal, en.stabilisation, en.hourglass, en.contact, en.friction,
       en.damping, en.external_work, en.eroded_kinetic, 100 * en.error(),
       100 * tc.energy_balance_limit);
+  // The kinetic share, stated whether or not the case checks it (a crush is dynamic: it states
+  // it; a forming run asks for quasi-static and is warned above when it is not).
+  if (tc.quasi_static_from < en.time)
+    r.log->info("kinetic / internal energy from t = {:.4g} s: at most {:.3g}, at the end {:.3g}{}",
+                tc.quasi_static_from, r.ke_ie_max, en.internal > 0 ? en.kinetic / en.internal : 0.0,
+                tc.kinetic_to_internal_limit > 0
+                    ? fmt::format(" (limit {:.3g}{})", tc.kinetic_to_internal_limit,
+                                  r.ke_ie_exceeded ? ", passed: not quasi-static" : "")
+                    : std::string(" (a dynamic run: not checked, time.kinetic_to_internal_limit "
+                                  "unset)"));
   if (solver.n_freed_nodes() > 0)
     r.log->info("{} nodes left with no element by erosion were taken out (held, out of contact)",
                 solver.n_freed_nodes());

@@ -105,6 +105,16 @@ void add_state_summary(const fem::ExplicitSolver& solver, double max_error, json
   summary["hourglass_to_internal_ratio"] =
       en.internal != 0 ? en.hourglass / std::abs(en.internal) : 0.0;
   summary["eroded_elements"] = solver.erosions().size();
+  {
+    using Cause = fem::ErosionEvent::Cause;
+    std::int64_t n[4] = {};
+    for (const auto& ev : solver.erosions()) ++n[static_cast<int>(ev.cause)];
+    const auto of = [&](Cause c) { return n[static_cast<int>(c)]; };
+    summary["eroded_elements_by_cause"] = {{"stable_step", of(Cause::StableStep)},
+                                           {"folded_corner", of(Cause::InvertedCorner)},
+                                           {"material_failure", of(Cause::MaterialFailure)},
+                                           {"mass_cap", of(Cause::MassCap)}};
+  }
   summary["eroded_internal_energy_J"] = en.eroded_internal;
   summary["eroded_kinetic_energy_J"] = en.eroded_kinetic;
   summary["freed_nodes"] = solver.n_freed_nodes();

@@ -103,24 +103,62 @@ int refuse_many_ranks() {
 
 const std::vector<Stage>& stages() {
   static const std::vector<Stage> registry{
-      {"engine", "explicit finite-element run (virtual tests, forming, crush)", &run_engine_stage,
-       &check_engine_stage},
+      {"engine",
+       "explicit finite-element run (virtual tests, forming, crush)",
+       &run_engine_stage,
+       &check_engine_stage,
+       true,
+       false,
+       {{"formed_shear_iso.png", "the formed part by shear angle"}},
+       "",
+       ""},
       {"crush",
        "explicit crush of an impregnated part from a transfer (tow damage per mode, cohesive "
        "resin bonds, punch force filtered at a CFC class)",
-       &run_engine_stage, &check_engine_stage},
+       &run_engine_stage,
+       &check_engine_stage,
+       true,
+       false,
+       {{"crush_force.png", "punch force against stroke"},
+        {"failed_mode.png", "failed mode per tow element"}},
+       "",
+       ""},
       {"kinematic_drape",
        "pin-jointed net (fishnet) drape on rigid tool surfaces, ring shear measure",
-       &run_kinematic_drape_stage, &check_kinematic_drape_stage},
+       &run_kinematic_drape_stage,
+       &check_kinematic_drape_stage,
+       false,
+       false,
+       {},
+       "kinematic_shear_deg",
+       " (pin-jointed net)"},
       {"transfer",
        "draped tows to the impregnated composite model (micromechanics, Vf from compaction, ties)",
-       &run_transfer_stage, &check_transfer_stage},
+       &run_transfer_stage,
+       &check_transfer_stage,
+       false,
+       false,
+       {},
+       "",
+       ""},
       {"workflow",
        "stages (drape, fishnet, transfer, crush, ...) from case files of their own into one "
        "folder, unchanged stages skipped, one report",
-       &run_workflow_stage, &check_workflow_stage},
+       &run_workflow_stage,
+       &check_workflow_stage,
+       false,
+       true,
+       {},
+       "",
+       ""},
   };
   return registry;
+}
+
+const Stage* stage_of_kind(const std::string& kind) {
+  for (const auto& s : stages())
+    if (s.kind == kind) return &s;
+  return nullptr;
 }
 
 const Stage& find_stage(const std::string& kind, const std::filesystem::path& file) {
@@ -144,27 +182,54 @@ std::string case_kind(const std::filesystem::path& file,
   return *kind;
 }
 
-bool is_time_loop_kind(const std::string& kind) { return kind == "engine" || kind == "crush"; }
+std::filesystem::path run_output_folder(const std::filesystem::path& file,
+                                        const std::vector<std::string>& overrides,
+                                        const std::string& out_dir) {
+  if (!out_dir.empty()) return out_dir;
+  const fem::CaseDocument doc = fem::CaseDocument::load(file, overrides);
+  const auto name = doc.root()["case"]["name"].value<std::string>();
+  return name ? std::filesystem::path("results") / *name : std::filesystem::path();
+}
+
+bool is_time_loop_kind(const std::string& kind) {
+  const Stage* s = stage_of_kind(kind);
+  return s && s->time_loop;
+}
+
+namespace {
+// "engine and crush": the kinds split over ranks, for messages.
+std::string time_loop_kinds() {
+  std::vector<std::string> k;
+  for (const auto& s : stages())
+    if (s.time_loop) k.push_back(s.kind);
+  std::string out;
+  for (std::size_t i = 0; i < k.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == k.size() ? " and " : ", ") + k[i];
+  return out;
+}
+}  // namespace
 
 int run_stage(const StageCall& call) {
   const std::string kind = case_kind(call.case_file, call.overrides);
-  // Only time-loop runs write checkpoints; the other stages are short and rerun.
-  if (call.options.resume && !is_time_loop_kind(kind) && kind != "workflow")
+  const Stage& stage = find_stage(kind, call.case_file);
+  // Only time-loop runs write checkpoints (a workflow passes --resume on to its stages); the
+  // other stages are short and rerun.
+  if (call.options.resume && !stage.time_loop && !stage.holds_stages)
     throw InputError(
         call.case_file.string(), "--resume",
         "a '" + kind + "' stage keeps no checkpoint (it is short): run it without --resume");
   // Several ranks (docs/parallel.md): the time-loop runs only. Read from the launcher's
   // environment: the other stages never start MPI.
-  if (kind == "workflow" && launcher_world_size() > 1)
+  if (stage.holds_stages && launcher_world_size() > 1)
     throw InputError(call.case_file.string(), "--np",
-                     "a workflow runs on one MPI rank: start it without mpirun; `ncfsim run "
-                     "WORKFLOW --np N` runs its engine stages on N ranks each");
-  if (!is_time_loop_kind(kind) && launcher_world_size() > 1)
+                     "a " + kind + " runs on one MPI rank: start it without mpirun; `ncfsim run " +
+                         "CASE --np N` runs its " + time_loop_kinds() + " stages on N ranks each");
+  if (!stage.time_loop && launcher_world_size() > 1)
     throw InputError(call.case_file.string(), "--np",
-                     "a '" + kind + "' stage runs on one MPI rank (only engine and crush cases " +
-                         "are split over ranks): run it without --np / mpirun, or give --np to " +
-                         "the stage cases themselves");
-  return find_stage(kind, call.case_file).run(call);
+                     "a '" + kind + "' stage runs on one MPI rank (only " + time_loop_kinds() +
+                         " cases are split over ranks): run it without --np / mpirun, or give "
+                         "--np to the stage cases themselves");
+  return stage.run(call);
 }
 
 int check_stage(const StageCall& call) {

@@ -2,8 +2,6 @@
 
 #include <fmt/format.h>
 #include <spdlog/logger.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -23,6 +21,7 @@
 #include "fem/petsc_vector.hpp"
 #include "workflow/case/case_hash.hpp"
 #include "workflow/output/output_files.hpp"
+#include "workflow/output/run_status.hpp"
 #include "workflow/render/render.hpp"
 #include "workflow/report/report.hpp"
 #include "workflow/run/mpi_launch.hpp"
@@ -111,17 +110,18 @@ std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out, int ran
       p.overrides.push_back(key + "=" +
                             json(fs::absolute(out / up / "results.h5").string()).dump());
     p.kind = case_kind(s.case_file, p.overrides);
-    if (p.kind == "workflow")
+    // A known kind, or bad input naming the stage's file.
+    const Stage& stage = find_stage(p.kind, s.case_file);
+    if (stage.holds_stages)
       throw InputError(
           wc.file.string(), "stage",
-          "stage '" + s.name + "' is itself a workflow (" + s.case_file.string() + ")");
-    find_stage(p.kind, s.case_file);  // a known kind, or bad input naming the stage's file
-    if (s.ranks > 1 && !is_time_loop_kind(p.kind))
+          "stage '" + s.name + "' is itself a " + p.kind + " (" + s.case_file.string() + ")");
+    if (s.ranks > 1 && !stage.time_loop)
       throw InputError(wc.file.string(), "stage.ranks",
                        "stage '" + s.name + "' is a '" + p.kind +
-                           "' stage: it runs on one MPI rank (only engine and crush stages are "
-                           "split over ranks): ranks = 1 or leave it out");
-    p.ranks = s.ranks > 0 ? s.ranks : is_time_loop_kind(p.kind) ? ranks : 1;
+                           "' stage: it runs on one MPI rank (only time-loop stages are split "
+                           "over ranks): ranks = 1 or leave it out");
+    p.ranks = s.ranks > 0 ? s.ranks : stage.time_loop ? ranks : 1;
     hash_stage(p, hashes);
     hashes[s.name] = p.hash;
     plans.push_back(std::move(p));
@@ -138,7 +138,8 @@ struct StageOutcome {
 // An engine or crush stage on several ranks: `launcher -n N ncfsim run CASE -o FOLDER --set ...`
 // as a child process in a process group of its own (so that the terminal's Ctrl-C reaches the
 // workflow only, which passes one SIGINT on to the stage's ranks: they checkpoint at one cycle).
-// The child gets SIGTERM if the workflow dies. Returns the child's exit code.
+// The child gets SIGTERM if the workflow dies. A rank lost ends the stage failed, the rank named
+// in its summary. Returns the child's exit code.
 int run_on_ranks(const StagePlan& p, const StageCall& sc, spdlog::logger& log,
                  const std::string& tag) {
   if (std::string(mpi_launcher()).empty())
@@ -164,46 +165,19 @@ int run_on_ranks(const StagePlan& p, const StageCall& sc, spdlog::logger& log,
     if (!(k > 0 && args[k - 1] == "--inputs-hash")) shown += (shown.empty() ? "" : " ") + args[k];
   log.info("{} on {} MPI ranks: {}", tag, p.ranks, shown);
   log.flush();
-  std::vector<char*> cargs;
-  for (auto& a : args) cargs.push_back(a.data());
-  cargs.push_back(nullptr);
-  std::vector<std::string> env = launcher_environment();
-  std::vector<char*> cenv;
-  for (auto& e : env) cenv.push_back(e.data());
-  cenv.push_back(nullptr);
-  std::fflush(nullptr);
-  const pid_t parent = getpid();
-  const pid_t pid = fork();
-  if (pid < 0)
-    throw std::runtime_error(std::string("cannot start the stage's ranks: ") +
-                             std::strerror(errno));
-  if (pid == 0) {
-    setpgid(0, 0);
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (getppid() != parent) _exit(kOtherError);  // the workflow died before prctl
-    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE}) std::signal(sig, SIG_DFL);
-    execve(cargs[0], cargs.data(), cenv.data());
-    std::fprintf(stderr, "ncfsim: cannot start the MPI launcher '%s': %s\n", cargs[0],
-                 std::strerror(errno));
-    _exit(kBadInput);
-  }
-  setpgid(pid, pid);  // also here: no window where a signal to -pid misses it
   bool passed_on = false;
-  int status = 0;
-  while (true) {
-    const pid_t r = waitpid(pid, &status, WNOHANG);
-    if (r == pid) break;
-    if (r < 0 && errno != EINTR) return kOtherError;
-    if (StopRequest::requested() && !passed_on) {
-      kill(-pid, SIGINT);
-      passed_on = true;
-      log.info("{} interrupt passed on to the stage's ranks", tag);
-    }
-    usleep(50'000);
+  const LauncherExit ex = run_launcher(args, launcher_environment(), SIGTERM, [&] {
+    if (passed_on || !StopRequest::requested()) return false;
+    log.info("{} interrupt passed on to the stage's ranks", tag);
+    return passed_on = true;
+  });
+  if (ex.exit_code != 0) {
+    if (!ex.lost_rank.empty())
+      log.error("{} MPI {} was lost; the launcher ended the other ranks", tag, ex.lost_rank);
+    if (record_lost_rank(sc.options.out_dir, ex.lost_rank, ex.exit_code, p.ranks))
+      log.error("{} its summary.json said running: now failed", tag);
   }
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  log.error("{} the stage's launcher ended by signal {}", tag, WTERMSIG(status));
-  return kOtherError;
+  return ex.exit_code;
 }
 
 // Runs one stage into its folder; its stage_inputs.json is removed first, so a stage stopped
@@ -411,10 +385,10 @@ int check_workflow_stage(const StageCall& call) {
     sc.case_file = s.case_file;
     sc.overrides = s.overrides;
     const std::string kind = case_kind(s.case_file, s.overrides);
-    if (kind == "workflow")
-      throw InputError(call.case_file.string(), "stage",
-                       "stage '" + s.name + "' is itself a workflow");
     const Stage& st = find_stage(kind, s.case_file);
+    if (st.holds_stages)
+      throw InputError(call.case_file.string(), "stage",
+                       "stage '" + s.name + "' is itself a " + kind);
     if (s.inputs.empty()) {
       if (const int rc = st.check(sc)) return rc;
     } else {  // its inputs do not exist before the upstream stages ran: the case must parse
@@ -454,17 +428,18 @@ bool ring_plot(const fs::path& dir, const json& stages, std::string& why) {
     try {
       const CsvTable t = read_csv(csv);
       const auto az = t.column("azimuth_deg");
-      const bool kinematic = e["kind"] == "kinematic_drape";
+      const Stage* stage = stage_of_kind(e.value("kind", ""));
+      const bool own_column = stage && !stage->ring_column.empty();
       const bool macro =
           std::find(t.columns.begin(), t.columns.end(), "macro_shear_deg") != t.columns.end();
-      const auto y = t.column(kinematic ? "kinematic_shear_deg"
-                              : macro   ? "macro_shear_deg"
-                                        : "shear_deg");
+      const auto y = t.column(own_column ? stage->ring_column
+                              : macro    ? "macro_shear_deg"
+                                         : "shear_deg");
       render::CurveSeries s;
-      s.label = e["name"].get<std::string>() + (kinematic ? " (pin-jointed net)"
-                                                : macro   ? " (macro shells)"
-                                                          : "");
-      s.dashed = kinematic;
+      s.label = e["name"].get<std::string>() + (own_column ? stage->ring_label
+                                                : macro    ? " (macro shells)"
+                                                           : "");
+      s.dashed = own_column;  // a reference drape beside the meso ones
       for (std::size_t i = 0; i < az.size(); ++i)
         if (std::isfinite(y[i])) s.x.push_back(az[i]), s.y.push_back(y[i]);
       plot.series.push_back(std::move(s));
@@ -580,7 +555,11 @@ void key_results_section(std::ostream& h, const json& stages,
       if (!ss.contains(k)) continue;
       std::string value =
           escape(ss[k].is_number() ? fmt::format("{:.4g}", ss[k].get<double>()) : ss[k].dump());
-      // A check the stage failed shows as a warning, not as a plain number.
+      // A check the stage failed shows as a warning, not as a plain number; a dynamic run
+      // (no limit set, e.g. a crush) states its kinetic share as such.
+      if (std::string(k) == "kinetic_to_internal_max" &&
+          !(ss.value("kinetic_to_internal_limit", 0.0) > 0))
+        value += " (a dynamic run: stated, not checked)";
       if (std::string(k) == "kinetic_to_internal_max" &&
           ss.value("kinetic_to_internal_exceeded", false))
         value = fmt::format(
@@ -634,12 +613,9 @@ void headline_section(std::ostream& h, const fs::path& dir, const json& stages) 
       << escape(caption) << "\"><figcaption>" << escape(caption) << "</figcaption></figure>\n";
   };
   for (const auto& e : stages) {
-    const std::string nm = e["name"].get<std::string>(), kind = e.value("kind", "");
-    if (kind == "engine") add(nm, "formed_shear_iso.png", nm + ": the formed part by shear angle");
-    if (kind == "crush") {
-      add(nm, "crush_force.png", nm + ": punch force against stroke");
-      add(nm, "failed_mode.png", nm + ": failed mode per tow element");
-    }
+    const std::string nm = e["name"].get<std::string>();
+    if (const Stage* stage = stage_of_kind(e.value("kind", "")))
+      for (const auto& h : stage->headline) add(nm, h.png, nm + ": " + h.caption);
   }
   if (!f.str().empty()) h << "<h2>Results</h2>\n" << f.str();
 }
