@@ -41,7 +41,7 @@ class Hex8Group final : public ElementGroup {
                                           double* dm) override {
     std::vector<double> dt;
     hex8_element_steps(block, x, dt, nullptr, true);
-    const double cap = (1 + max_added_ratio) * block.material->density();
+    const double cap = mass_cap_density(max_added_ratio);
     DynamicScalingResult r;
     for (std::size_t e = block.range_begin; e < std::min(block.range_end, block.n); ++e) {
       // Below the target (eroded: 1e300); at the cap: left to its step.
@@ -68,7 +68,11 @@ class Hex8Group final : public ElementGroup {
     return r;
   }
   bool at_mass_cap(std::size_t e, double max_added_ratio) const override {
-    return block.density[e] >= (1 + max_added_ratio) * block.material->density();
+    return block.density[e] >= mass_cap_density(max_added_ratio);
+  }
+  // The density at the cap of dynamic mass scaling: (1 + ratio) times the material's.
+  double mass_cap_density(double max_added_ratio) const {
+    return (1 + max_added_ratio) * block.material->density();
   }
   StableStep stable_step(const double* x) const override { return hex8_stable_step(block, x); }
   void internal_forces(const ElementCycleState& s, double* f, ElementEnergyIncrement& energy,

@@ -191,11 +191,6 @@ std::filesystem::path run_output_folder(const std::filesystem::path& file,
   return name ? std::filesystem::path("results") / *name : std::filesystem::path();
 }
 
-bool is_time_loop_kind(const std::string& kind) {
-  const Stage* s = stage_of_kind(kind);
-  return s && s->time_loop;
-}
-
 namespace {
 // "engine and crush": the kinds split over ranks, for messages.
 std::string time_loop_kinds() {

@@ -66,9 +66,6 @@ std::filesystem::path run_output_folder(const std::filesystem::path& file,
                                         const std::vector<std::string>& overrides,
                                         const std::string& out_dir);
 
-/// Whether a stage kind is a time-loop run (Stage::time_loop; false for an unknown kind).
-bool is_time_loop_kind(const std::string& kind);
-
 /// Looks the case's kind up and runs its stage.
 int run_stage(const StageCall& call);
 /// Looks the case's kind up and checks it (`ncfsim check`).

@@ -165,11 +165,11 @@ int run_on_ranks(const StagePlan& p, const StageCall& sc, spdlog::logger& log,
     if (!(k > 0 && args[k - 1] == "--inputs-hash")) shown += (shown.empty() ? "" : " ") + args[k];
   log.info("{} on {} MPI ranks: {}", tag, p.ranks, shown);
   log.flush();
-  bool passed_on = false;
+  // run_launcher asks until the answer is yes, once.
   const LauncherExit ex = run_launcher(args, launcher_environment(), SIGTERM, [&] {
-    if (passed_on || !StopRequest::requested()) return false;
+    if (!StopRequest::requested()) return false;
     log.info("{} interrupt passed on to the stage's ranks", tag);
-    return passed_on = true;
+    return true;
   });
   if (ex.exit_code != 0) {
     if (!ex.lost_rank.empty())
