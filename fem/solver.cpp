@@ -307,7 +307,9 @@ void ExplicitSolver::erode_and_choose_step(const CycleArrays& a, Cycle& c) {
   const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
   // With time.mass_scaling_erode_at_cap, an element at the mass cap is eroded once its step is
   // below the target: looked for whenever the step is.
-  const double cap_dt = model_.time.mass_scaling_erode_at_cap ? model_.time.mass_scaling_dt : 0.0;
+  const double cap_dt = model_.time.mass_scaling_erode_at_cap
+                            ? model_.time.mass_scaling_dt * (1 - kMassScalingBelowShare)
+                            : 0.0;
   if (dt_erode > 0 || cap_dt > 0 || material_failure_) {
     bool check_steps = false;
     if (dt_erode > 0 || cap_dt > 0) {
@@ -315,7 +317,8 @@ void ExplicitSolver::erode_and_choose_step(const CycleArrays& a, Cycle& c) {
       for (std::size_t k = 0; k < groups_.size(); ++k)
         if (groups_[k]->can_erode()) take_smaller(erodible, group_step_[k]);
       const double sf_dt = model_.time.safety_factor * erodible.dt;
-      check_steps = sf_dt < dt_erode || sf_dt < cap_dt || cycle_ % kFoldCheckInterval == 0;
+      check_steps = sf_dt < dt_erode || cycle_ % kFoldCheckInterval == 0 ||
+                    (sf_dt < cap_dt && capped_below(a.x, cap_dt));
     }
     erode(a.x, a.v, dt_erode, check_steps, c.blow_up);
   }
@@ -330,6 +333,22 @@ void ExplicitSolver::erode_and_choose_step(const CycleArrays& a, Cycle& c) {
   c.dt_new = model_.time.safety_factor * c.st.dt;
   if (dt_prev_ > 0) c.dt_new = std::min(c.dt_new, 1.1 * dt_prev_);  // limit step growth
   if (c.st.element < 0 && dt_prev_ > 0) c.dt_new = dt_prev_;  // every element eroded: no bound
+}
+
+// Whether an element of this rank at the cap of dynamic mass scaling has its step below cap_dt;
+// only those elements are measured. The statically scaled tows' step sits at the target (a
+// rounding below it, in the kernel's arithmetic), so "the step below the target" alone measured
+// every element every cycle: 17 ms of a 79 ms cycle of the paper's model on one rank.
+bool ExplicitSolver::capped_below(const double* x, double cap_dt) {
+  if (mass_scaling_capped_ == 0) return false;
+  const double sf = model_.time.safety_factor;
+  for (const auto& g : groups_) {
+    if (!g->can_erode()) continue;
+    g->capped_element_steps(x, model_.time.mass_scaling_max_ratio, step_scratch_);
+    for (const double dt : step_scratch_)
+      if (sf * dt < cap_dt) return true;
+  }
+  return false;
 }
 
 // Contact forces at x^n: rigid tools, contacts (which may lower the step), rigs' walls.

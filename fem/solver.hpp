@@ -12,6 +12,7 @@
 #include "fem/boundary/boundary_motion.hpp"
 #include "fem/elements/element_group.hpp"
 #include "fem/energy.hpp"
+#include "fem/huge_pages.hpp"
 #include "fem/model.hpp"
 #include "fem/petsc_vector.hpp"
 
@@ -91,6 +92,8 @@ class ExplicitSolver {
 
   double time() const { return t_; }
   double time_step() const { return dt_; }
+  /// What the set-up got of 2 MB pages for the model's arrays (fem/huge_pages.hpp).
+  const HugePageAdvice& huge_pages() const { return huge_pages_; }
   std::int64_t cycle() const { return cycle_; }
   const EnergyBalance& energy() const { return energy_; }
   const StableStep& controlling_element() const { return step_; }
@@ -242,6 +245,9 @@ class ExplicitSolver {
   /// ranks found together in a reduction (`from` = size: none, returns).
   void throw_blow_up_of(int from, const std::string& what) const;
   void build_motions();
+  /// Whether an element of this rank at the cap of dynamic mass scaling has its step below
+  /// cap_dt (only those are measured; none while no element has reached the cap).
+  bool capped_below(const double* x, double cap_dt);
   /// Erodes every element of the groups that can lose elements whose step at x (times the
   /// safety factor) is below dt_erode or one of whose corners has folded over (corner Jacobian
   /// <= 0); those groups' steps (group_step_) become the stable step of the elements left.
@@ -302,6 +308,7 @@ class ExplicitSolver {
   std::vector<ErodedForce> eroded_forces_;
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
+  HugePageAdvice huge_pages_;
   // Sum over the cycles of a bound on this rank's largest node displacement in each (m): the
   // rigid tools' proximity cull compares its growth with their margin (not checkpointed: after a
   // resume the tools check once and start from there).

@@ -11,6 +11,7 @@
 #include "fem/boundary/picture_frame_motion.hpp"
 #include "fem/checkpoint.hpp"
 #include "fem/errors.hpp"
+#include "fem/huge_pages.hpp"
 #include "fem/parallel/domain.hpp"
 #include "fem/solver.hpp"
 
@@ -154,6 +155,8 @@ ExplicitSolver::ExplicitSolver(Model& model) : model_(model) {
   }
   dt_initial_ = dt_;
   vpres_.resize(model_.velocities.size());
+  // The model's arrays are all allocated now: on 2 MB pages from here (no value changes).
+  huge_pages_ = advise_huge_pages();
 }
 
 // One group per kind and part, kinds in ElementKind order: element forces are summed in this order.
@@ -274,7 +277,9 @@ void ExplicitSolver::assemble_mass() {
 // closed; the added mass is reported per part.
 void ExplicitSolver::scale_mass_dynamic(double* x, double* v, double* m) {
   const double target = model_.time.mass_scaling_dt, sf = model_.time.safety_factor;
-  if (cycle_ == 0 || step_.kind != ElementKind::Hex8 || !(sf * step_.dt < target)) return;
+  if (cycle_ == 0 || step_.kind != ElementKind::Hex8 ||
+      !(sf * step_.dt < target * (1 - kMassScalingBelowShare)))
+    return;
   if (cycle_ < mass_scaling_pause_until_) return;
   constexpr double kHeadroom = 1.05;
   constexpr std::int64_t kPauseCycles = 50;

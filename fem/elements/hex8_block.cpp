@@ -313,7 +313,7 @@ void hex8_lumped_mass(const Hex8Block& b, double* mass) {
 }
 
 void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt,
-                        std::vector<double>* corner_jacobian, bool in_range) {
+                        std::vector<double>* corner_jacobian, bool in_range, double min_density) {
   // The three edges leaving each corner, right-handed (bottom face 0-3, top 4-7 above them).
   constexpr int kEdges[8][3] = {{1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7},
                                 {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}};
@@ -322,7 +322,7 @@ void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>
   const std::size_t e_begin = in_range ? std::min(b.n, b.range_begin) : 0;
   const std::size_t e_end = in_range ? std::min(b.n, b.range_end) : b.n;
   for (std::size_t e = 0; e < b.n; ++e) {
-    if ((b.n_eroded && b.eroded[e]) || e < e_begin || e >= e_end) {
+    if ((b.n_eroded && b.eroded[e]) || e < e_begin || e >= e_end || b.density[e] < min_density) {
       dt[e] = 1e300;
       if (corner_jacobian) (*corner_jacobian)[e] = 1.0;
       continue;
@@ -536,7 +536,7 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
 
   // The element state is ~50 separate [component][n] streams, more than the hardware prefetchers
   // follow: every stream of the chunk kAhead chunks ahead is requested (into L2) while this one
-  // computes.
+  // computes, the material's history with them, and the chunk's nodes.
   auto prefetch_chunk = [&](std::size_t c0) {
     if (c0 >= std::min(n, b.range_end)) return;
     const std::size_t cn = std::min<std::size_t>(CH, n - c0);
@@ -559,6 +559,16 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
     rows(hgf, 12, write);
     if (zeta != 0) rows(hgv, 12, write);
     rows(b.volume.data(), 1, write);
+    if (!b.history.empty()) rows(b.history.data(), b.material->n_history(), write);
+    // The nodes, gathered through conn: each element's corners 0, 3, 4 and 7 start the four
+    // runs of node numbers its corners lie on (a tow's nodes are numbered along it), so these
+    // four bring in the lines of the others. 4-6 % of the paper model's cycle (bench_forming).
+    for (int I : {0, 3, 4, 7})
+      for (std::size_t k = 0; k < cn; ++k) {
+        const std::size_t i = 3 * static_cast<std::size_t>(conn[I * n + c0 + k]);
+        __builtin_prefetch(x + i, 0, 2);
+        __builtin_prefetch(v + i, 0, 2);
+      }
   };
   constexpr std::size_t kAhead = 4;  // chunks
   const std::size_t e_begin = b.range_begin, e_end = std::min(n, b.range_end);

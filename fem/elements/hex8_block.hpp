@@ -106,9 +106,12 @@ void hex8_lumped_mass(const Hex8Block& b, double* mass);
 StableStep hex8_stable_step(const Hex8Block& b, const double* x);
 /// in_range: only the elements of this rank's range (b.range_begin..range_end) are measured,
 /// the others get a step of 1e300 and a corner Jacobian of 1 (several ranks: they are another
-/// rank's, and this rank's copies of their nodes may be stale).
+/// rank's, and this rank's copies of their nodes may be stale). min_density > 0: only elements
+/// at least that dense are measured (the others: 1e300, as eroded ones), e.g. those at the cap of
+/// dynamic mass scaling.
 void hex8_element_steps(const Hex8Block& b, const double* x, std::vector<double>& dt,
-                        std::vector<double>* corner_jacobian = nullptr, bool in_range = false);
+                        std::vector<double>* corner_jacobian = nullptr, bool in_range = false,
+                        double min_density = 0);
 
 /// Nodal internal forces f[8][3] (VTK node order of element e) that element e exerts on its
 /// nodes at positions x with velocities v, from its current state: what hex8_internal_forces

@@ -45,7 +45,7 @@ class Hex8Group final : public ElementGroup {
     DynamicScalingResult r;
     for (std::size_t e = block.range_begin; e < std::min(block.range_end, block.n); ++e) {
       // Below the target (eroded: 1e300); at the cap: left to its step.
-      if (!(sf * dt[e] < target)) {
+      if (!(sf * dt[e] < target * (1 - kMassScalingBelowShare))) {
         r.at_cap += block.density[e] >= cap ? 1 : 0;
         continue;
       }
@@ -98,6 +98,10 @@ class Hex8Group final : public ElementGroup {
   void element_steps(const double* x, std::vector<double>& dt,
                      std::vector<double>* corner_jacobian) const override {
     hex8_element_steps(block, x, dt, corner_jacobian, true);
+  }
+  void capped_element_steps(const double* x, double max_added_ratio,
+                            std::vector<double>& dt) const override {
+    hex8_element_steps(block, x, dt, nullptr, true, mass_cap_density(max_added_ratio));
   }
   void element_force(std::size_t e, const double* x, const double* v, double* f) const override {
     hex8_element_force(block, e, x, v, f);

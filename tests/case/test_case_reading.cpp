@@ -251,3 +251,34 @@ TEST(CaseReading, QuasiStaticWindowStartsInsideTheRun) {
     EXPECT_EQ(e.key(), "time.quasi_static_from") << e.what();
   }
 }
+
+// Dynamic mass scaling's keys (issue #41): each bad value names its own key and what is allowed.
+TEST(CaseReading, MassScalingKeysNameTheirRangeAndWhatTheyNeed) {
+  const std::filesystem::path file =
+      std::filesystem::path(NCFSIM_SOURCE_DIR) / "cases/verification/cantilever.toml";
+  const auto refused = [&](const std::vector<std::string>& sets, const std::string& key,
+                           const std::string& says) {
+    try {
+      workflow::load_engine_case(file, sets);
+      ADD_FAILURE() << key << ": accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("cantilever.toml"), std::string::npos) << e.what();
+    }
+  };
+  refused({"time.mass_scaling_dynamic=true"}, "time.mass_scaling_dynamic", "mass_scaling_dt > 0");
+  refused({"time.mass_scaling_dt=1e-6", "time.mass_scaling_dynamic=true",
+           "time.mass_scaling_max_ratio=0"},
+          "time.mass_scaling_max_ratio", "1e+06");
+  refused({"time.mass_scaling_dt=1e-6", "time.mass_scaling_dynamic=true",
+           "time.mass_scaling_max_ratio=2e6"},
+          "time.mass_scaling_max_ratio", "1e+06");
+  refused({"time.mass_scaling_erode_at_cap=true"}, "time.mass_scaling_erode_at_cap",
+          "mass_scaling_dynamic = true");
+  const auto ok = workflow::load_engine_case(
+      file, {"time.mass_scaling_dt=1e-6", "time.mass_scaling_dynamic=true",
+             "time.mass_scaling_max_ratio=3", "time.mass_scaling_erode_at_cap=true"});
+  EXPECT_EQ(ok.model.time.mass_scaling_max_ratio, 3.0);
+  EXPECT_TRUE(ok.model.time.mass_scaling_erode_at_cap);
+}

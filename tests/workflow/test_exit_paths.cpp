@@ -3,6 +3,8 @@
 //  * SIGTERM, SIGHUP, SIGQUIT mid-run end like Ctrl-C: exit 1, status interrupted, summary.json
 //    and results readable; so does a signal the moment the handler is in place, before the case
 //    is read (before, a signal in the first 0.4 s left no output folder);
+//  * two signals within a second (a batch system or pkill signalling every process of a job, and
+//    the launcher of --np passing it on) are one request: the run still writes its summary;
 //  * a closed stdout (ncfsim run ... | head -1) does not kill the run: it completes, exit 0, and
 //    log.txt keeps every line.
 #include <gtest/gtest.h>
@@ -29,6 +31,18 @@ std::vector<std::string> long_run(const fs::path& out) {
           "--set", "output.report=false"};
 }
 
+// Whether the run writing into out reports itself running within 30 s.
+bool reaches_running(const fs::path& out) {
+  for (int i = 0; i < 600; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    try {
+      if (fs::exists(out / "summary.json") && summary(out)["status"] == "running") return true;
+    } catch (const std::exception&) {
+    }
+  }
+  return false;
+}
+
 TEST(CliExitPaths, CycleLimitExitsOne) {
   const fs::path out = fresh_dir("exit_max_cycles");
   const auto r =
@@ -42,20 +56,26 @@ TEST(CliExitPaths, TerminationSignalsEndLikeCtrlC) {
     const fs::path out = fresh_dir("exit_signal_" + std::to_string(sig));
     const fs::path log = out.string() + ".log";
     const pid_t pid = spawn(long_run(out), log);
-    bool running = false;
-    for (int i = 0; i < 600 && !running; ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      try {
-        running = fs::exists(out / "summary.json") && summary(out)["status"] == "running";
-      } catch (const std::exception&) {
-      }
-    }
-    ASSERT_TRUE(running) << slurp(log);
+    ASSERT_TRUE(reaches_running(out)) << slurp(log);
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     kill(pid, sig);
     EXPECT_EQ(wait_code(pid), 1) << "signal " << sig << ": " << slurp(log);
     EXPECT_EQ(summary(out)["status"], "interrupted") << "signal " << sig;
   }
+}
+
+// A job's processes signalled all at once (scancel, pkill, and --np's launcher passing one on):
+// a rank may get the request twice within moments. Before, the second aborted the run (exit 130)
+// with its checkpoint written and summary.json left "running".
+TEST(CliExitPaths, TwoSignalsWithinASecondAreOneRequest) {
+  const fs::path out = fresh_dir("exit_two_signals");
+  const fs::path log = out.string() + ".log";
+  const pid_t pid = spawn(long_run(out), log);
+  ASSERT_TRUE(reaches_running(out)) << slurp(log);
+  kill(pid, SIGTERM);
+  kill(pid, SIGINT);
+  EXPECT_EQ(wait_code(pid), 1) << slurp(log);
+  EXPECT_EQ(summary(out)["status"], "interrupted");
 }
 
 // Whether process pid catches signal sig yet (/proc/<pid>/status, SigCgt).

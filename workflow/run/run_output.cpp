@@ -4,17 +4,38 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdint>
 #include <cstdlib>
+#include <ctime>
 
 namespace ncfsim::workflow {
 
 namespace {
 std::atomic<int> g_stop{0};
+std::atomic<std::int64_t> g_first_ns{0};  // when the first request came (CLOCK_MONOTONIC)
+
+// A batch system's or `pkill`'s signal reaches every process of a job, and `ncfsim run --np`
+// passes the user's Ctrl-C on to its ranks as well: a rank may see one request twice within
+// moments. Only a second signal after this long aborts.
+constexpr std::int64_t kSameRequestNs = 1'000'000'000;
+
+std::int64_t monotonic_ns() {  // clock_gettime is async-signal-safe
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
 extern "C" void on_sigint(int) {
-  if (g_stop.fetch_add(1) >= 1) std::_Exit(130);
+  const std::int64_t now = monotonic_ns();
+  if (g_stop.load() >= 1) {
+    if (now - g_first_ns.load() < kSameRequestNs) return;
+    std::_Exit(130);
+  }
+  g_first_ns.store(now);
+  g_stop.store(1);
   static const char msg[] =
       "\n[ncfsim] interrupt: stopping at the end of this cycle or step, keeping what is written "
-      "(Ctrl-C again to abort)\n";
+      "(Ctrl-C again, a second later, to abort)\n";
   [[maybe_unused]] auto r = ::write(2, msg, sizeof msg - 1);
 }
 }  // namespace

@@ -50,6 +50,7 @@ void describe_model(const fem::ExplicitSolver& solver, spdlog::logger& log, json
   const fem::Model& model = solver.model();
   log.info("mesh: {} nodes, {}, {} parts, {} tools", model.mesh.n_nodes(), element_counts(solver),
            model.mesh.part_names.size(), model.tools.size());
+  log.info("memory: {}", solver.huge_pages().describe());
   const auto& st = solver.controlling_element();
   log.info("stable step {:.4g} s (safety factor {}), controlled by {} {}", solver.time_step(),
            model.time.safety_factor, fem::element_noun(st.kind), st.element);
