@@ -37,8 +37,8 @@ struct CellFieldSpec {
 /// Dynamic mass scaling's target step, less this share, is what counts as below it: the elements
 /// scaled to the target at the start sit on it, a rounding either side (the hexahedron kernel's
 /// arithmetic and hex8_element_steps' differ in the last bits). Without it a step one rounding
-/// under the target started a scan every cycle that gave such elements 10 % more mass (the
-/// headroom): the paper model's plies gained 63 % where the static scaling gives 36 %.
+/// under the target could start a scan every cycle that gave such elements 10 % more mass (the
+/// headroom; test DynamicMassScaling.StepARoundingBelowTheTargetGetsNoMass).
 inline constexpr double kMassScalingBelowShare = 1e-9;
 
 /// What one pass of dynamic mass scaling did on a group: the mass added (kg), the elements
