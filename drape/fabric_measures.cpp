@@ -7,6 +7,7 @@
 
 #include "drape/kinematic_drape.hpp"
 #include "fem/contact/bucket_grid.hpp"
+#include "fem/elements/element_kind.hpp"
 
 namespace ncfsim::drape {
 
@@ -68,12 +69,11 @@ void interply_shear_deg(const std::vector<V3>& centroid, const std::vector<V3>& 
 std::vector<std::array<std::int32_t, 3>> outer_face_triangles(
     const std::vector<std::array<std::int32_t, 8>>& conn,
     const std::vector<std::int32_t>& elements) {
-  static constexpr int kFace[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                                      {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
   std::map<std::array<std::int32_t, 4>, std::pair<int, std::array<std::int32_t, 4>>> faces;
   for (auto e : elements) {
     const auto& h = conn[static_cast<std::size_t>(e)];
-    for (const auto& f : kFace) {
+    for (const auto& face : fem::kHex8Faces) {
+      const auto& f = face.corner;
       std::array<std::int32_t, 4> nodes{
           h[static_cast<std::size_t>(f[0])], h[static_cast<std::size_t>(f[1])],
           h[static_cast<std::size_t>(f[2])], h[static_cast<std::size_t>(f[3])]};

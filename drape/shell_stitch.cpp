@@ -4,19 +4,13 @@
 #include <cmath>
 
 #include "fem/errors.hpp"
+#include "fem/vec3.hpp"
 
 namespace ncfsim::drape {
 
 namespace {
 
-using V = std::array<double, 3>;
-V sub(const V& a, const V& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const V& a, const V& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-V cross(const V& a, const V& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm(const V& a) { return std::sqrt(dot(a, a)); }
-V scaled(const V& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+using fem::V3;
 
 // A quadrilateral in the plane's coordinates (along the wale, across it).
 struct PlaneQuad {
@@ -79,29 +73,32 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
   if (quads.empty())
     throw InputError(file, key + ".part", "the part has no shells to sew the stitch onto");
   // The plane of the part, from its first shell; every node of the part must lie in it.
-  auto X = [&](std::int32_t nd) { return mesh.node(static_cast<std::size_t>(nd)); };
+  auto X = [&](std::int32_t nd) { return V3::from(mesh.node(static_cast<std::size_t>(nd))); };
   const auto q0 = shells.nodes(quads[0]);
-  V normal = cross(sub(X(q0[2]), X(q0[0])), sub(X(q0[3]), X(q0[1])));
+  V3 normal = cross(X(q0[2]) - X(q0[0]), X(q0[3]) - X(q0[1]));
   if (!(norm(normal) > 0)) throw InputError(file, key + ".part", "its first shell is degenerate");
-  normal = scaled(normal, 1 / norm(normal));
-  const V origin = X(q0[0]);
-  V lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  normal = (1 / norm(normal)) * normal;
+  const V3 origin = X(q0[0]);
+  V3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (auto e : quads)
+    for (auto nd : shells.nodes(e)) {
+      const V3 p = X(nd);
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+  const double size = norm(hi - lo);
   for (auto e : quads)
     for (auto nd : shells.nodes(e))
-      for (int k = 0; k < 3; ++k)
-        lo[k] = std::min(lo[k], X(nd)[k]), hi[k] = std::max(hi[k], X(nd)[k]);
-  const double size = norm(sub(hi, lo));
-  for (auto e : quads)
-    for (auto nd : shells.nodes(e))
-      if (std::abs(dot(sub(X(nd), origin), normal)) > 1e-6 * size)
+      if (std::abs(dot(X(nd) - origin, normal)) > 1e-6 * size)
         throw InputError(file, key + ".part",
                          "the part must be flat at set-up (a blank): its shells leave the plane of "
                          "its first shell");
-  V t = sub(spec.direction, scaled(normal, dot(spec.direction, normal)));
-  if (!(norm(t) > 1e-6 * norm(spec.direction)))
+  const V3 direction = V3::from(spec.direction);
+  V3 t = direction - dot(direction, normal) * normal;
+  if (!(norm(t) > 1e-6 * norm(direction)))
     throw InputError(file, key + ".direction", "must not be normal to the part's plane");
-  t = scaled(t, 1 / norm(t));
-  const V across = cross(normal, t);
+  t = (1 / norm(t)) * t;
+  const V3 across = cross(normal, t);
 
   std::vector<PlaneQuad> pq;
   double cmin = 1e300, cmax = -1e300;
@@ -109,7 +106,7 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
     PlaneQuad q;
     for (int k = 0; k < 4; ++k) {
       q.nodes[k] = shells.nodes(e)[static_cast<std::size_t>(k)];
-      const V d = sub(X(q.nodes[k]), origin);
+      const V3 d = X(q.nodes[k]) - origin;
       q.s[k] = dot(d, t), q.c[k] = dot(d, across);
       cmin = std::min(cmin, q.c[k]), cmax = std::max(cmax, q.c[k]);
     }
@@ -171,14 +168,13 @@ ShellStitchModel sew_shell_stitch(fem::Mesh& mesh, const ShellStitchSpec& spec, 
           throw InputError(file, key,
                            "a stitch point of line " + std::to_string(l) +
                                " lies in no shell (is the part convex where it is cut?)");
-        V p{0, 0, 0};
-        for (int k = 0; k < 4; ++k)
-          for (int d = 0; d < 3; ++d) p[d] += link.weight[k] * X(link.host[k])[d];
+        V3 p;
+        for (int k = 0; k < 4; ++k) p += link.weight[k] * X(link.host[k]);
         link.penetrations =
             out.pillar_share * (i == 0 || i == np ? 0.5 : 1.0) * (len / np) / spec.stitch_length;
         out.penetrations += link.penetrations;
         link.stitch_node = static_cast<std::int32_t>(mesh.n_nodes());
-        for (double v : p) mesh.coords.push_back(v);
+        for (double v : p.arr()) mesh.coords.push_back(v);
         if (i > 0) {
           auto& prev = out.links.back();
           link.prev = prev.stitch_node;

@@ -30,6 +30,7 @@ class StitchToShellConnection final : public fem::ContactAlgorithm {
                           ShellStitchSliderSettings s);
   const std::string& name() const override { return name_; }
   void initialise(const fem::ContactSetup& setup) override;
+  double estimated_bytes(const fem::Mesh& mesh, bool erosion) const override;
   void add_forces(const double* x, const double* v, const double* mass, double dt,
                   double* f_contact) override;
   double friction_dissipation() const override { return dissipated_; }

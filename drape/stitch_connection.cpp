@@ -7,19 +7,14 @@
 #include "fem/checkpoint.hpp"
 #include "fem/errors.hpp"
 #include "fem/mesh.hpp"
+#include "fem/vec3.hpp"
 
 namespace ncfsim::drape {
 
 namespace {
 
-inline void cross(const double* a, const double* b, double* c) {
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-inline double dot(const double* a, const double* b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+using fem::cross3;
+using fem::dot3;
 
 // The smallest rotation R that turns the unit vector t0 into the unit vector t (about t0 x t):
 // R v = c v + a x v + (a.v) a / (1 + c), c = t0.t, a = t0 x t.
@@ -27,14 +22,14 @@ struct TowTurn {
   double t0[3], t[3], a[3], c, len_u;
   void apply(const double* v, double* out) const {
     double axv[3];
-    cross(a, v, axv);
-    const double q = dot(a, v) / (1 + c);
+    cross3(a, v, axv);
+    const double q = dot3(a, v) / (1 + c);
     for (int k = 0; k < 3; ++k) out[k] = c * v[k] + axv[k] + q * a[k];
   }
   void apply_inverse(const double* v, double* out) const {  // R^T: the turn from t back to t0
     double axv[3];
-    cross(a, v, axv);
-    const double q = dot(a, v) / (1 + c);
+    cross3(a, v, axv);
+    const double q = dot3(a, v) / (1 + c);
     for (int k = 0; k < 3; ++k) out[k] = c * v[k] - axv[k] + q * a[k];
   }
   /// g = sum_j (d(R v_j)/d u)^T h_j, with t = u/|u| (u the tow axis vector the turn was made
@@ -50,15 +45,15 @@ struct TowTurn {
       Ma[p] = M[3 * p] * a[0] + M[3 * p + 1] * a[1] + M[3 * p + 2] * a[2];
       MTa[p] = M[p] * a[0] + M[3 + p] * a[1] + M[6 + p] * a[2];
     }
-    const double trM = M[0] + M[4] + M[8], aMa = dot(a, Ma);
+    const double trM = M[0] + M[4] + M[8], aMa = dot3(a, Ma);
     double sum_x_t0[3];
     const double s[3] = {MTa[0] + Ma[0], MTa[1] + Ma[1], MTa[2] + Ma[2]};
-    cross(s, t0, sum_x_t0);
+    cross3(s, t0, sum_x_t0);
     const double inv = 1 / (1 + c);
     double g_t[3];
     for (int k = 0; k < 3; ++k)
       g_t[k] = trM * t0[k] + Mt0[k] - MTt0[k] + sum_x_t0[k] * inv - aMa * inv * inv * t0[k];
-    const double gt = dot(g_t, t);
+    const double gt = dot3(g_t, t);
     for (int k = 0; k < 3; ++k) g[k] = (g_t[k] - gt * t[k]) / len_u;
   }
 };
@@ -74,10 +69,10 @@ inline void store(const TowTurn& r, double* out) {
 inline TowTurn tow_turn(const double* u, const double* t0) {
   TowTurn r;
   for (std::size_t k = 0; k < 3; ++k) r.t[k] = u[k], r.t0[k] = t0[k];
-  r.len_u = std::sqrt(dot(r.t, r.t));
+  r.len_u = std::sqrt(dot3(r.t, r.t));
   for (double& v : r.t) v /= r.len_u;
-  r.c = dot(t0, r.t);
-  cross(t0, r.t, r.a);
+  r.c = dot3(t0, r.t);
+  cross3(t0, r.t, r.a);
   return r;
 }
 
@@ -99,6 +94,15 @@ StitchToTowConnection::StitchToTowConnection(std::string name, std::vector<Stitc
   if (!(s.stiffness_scale > 0 && s.stiffness_scale <= 1)) throw std::invalid_argument("stiffness_scale must be in (0, 1]");
   for (const auto& p : pairs)
     a_.push_back(p.stitch_node), b_.push_back(p.tow_node), ax_.push_back(p.tow_axis_node);
+}
+
+// Per joint ~70 bytes, per axis hexahedron (a few joints share one) 260; the set-up's map from
+// every mesh node to its hexahedra (~90 bytes a node) and the slot of each hexahedron.
+double StitchToTowConnection::estimated_bytes(const fem::Mesh& mesh, bool erosion) const {
+  (void)erosion;
+  const double joints = static_cast<double>(a_.size());
+  return 70 * joints + 260 * joints / 2 + 90.0 * static_cast<double>(mesh.n_nodes()) +
+         4.0 * static_cast<double>(mesh.elements(fem::ElementKind::Hex8).size());
 }
 
 void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
@@ -157,12 +161,12 @@ void StitchToTowConnection::initialise(const fem::ContactSetup& setup) {
         const auto nd = static_cast<std::size_t>(hx[I]);
         const double rel[3] = {x0[3 * nd] - cen[0], x0[3 * nd + 1] - cen[1],
                                x0[3 * nd + 2] - cen[2]};
-        const double w = dot(rel, edge) > 0 ? 0.125 : -0.125;
+        const double w = dot3(rel, edge) > 0 ? 0.125 : -0.125;
         slot_nodes_.push_back(hx[I]);
         slot_w_.push_back(w);
         for (std::size_t k = 0; k < 3; ++k) u0[k] += w * x0[3 * nd + k];
       }
-      const double len = std::sqrt(dot(u0, u0));
+      const double len = std::sqrt(dot3(u0, u0));
       for (std::size_t k = 0; k < 3; ++k) slot_t0_.push_back(u0[k] / len);
     }
     joint_slot_[i] = slot;
@@ -218,7 +222,7 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
     // Return mapping, along the tow (the sliding force) and across it (the transverse limit, if
     // any) separately: the slider moves until the spring carries the limit; the slip goes into
     // the rest offset, turned back to the reference frame.
-    const double d_t = dot(d, R.t);
+    const double d_t = dot3(d, R.t);
     double dslip = 0, slip[3] = {0, 0, 0};
     if (kk * std::abs(d_t) > Fs) {
       const double ds = std::copysign((kk * std::abs(d_t) - Fs) / kk, d_t);
@@ -228,7 +232,7 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
     }
     double d_perp[3];
     for (int k = 0; k < 3; ++k) d_perp[k] = d[k] - d_t * R.t[k];
-    const double len_perp = std::sqrt(dot(d_perp, d_perp));
+    const double len_perp = std::sqrt(dot3(d_perp, d_perp));
     if (Ft > 0 && kk * len_perp > Ft) {
       const double q = (kk * len_perp - Ft) / (kk * len_perp);  // share of it that slips
       for (int k = 0; k < 3; ++k) slip[k] += q * d_perp[k];
@@ -242,7 +246,7 @@ void StitchToTowConnection::add_forces(const double* x, const double*, const dou
       slip_len_[i] += dslip;
       ++sliding;
     }
-    force_[i] = kk * std::sqrt(dot(d, d));
+    force_[i] = kk * std::sqrt(dot3(d, d));
     const double kd[3] = {kk * d[0], kk * d[1], kk * d[2]};  // pulls a towards b and b towards a
     for (std::size_t k = 0; k < 3; ++k) fc[3 * a + k] += kd[k], fc[3 * b + k] -= kd[k];
     double* M = &slot_m_[9 * h];

@@ -31,6 +31,7 @@ class StitchToTowConnection final : public fem::ContactAlgorithm {
   StitchToTowConnection(std::string name, std::vector<StitchConnection> pairs, StitchConnectionSettings s);
   const std::string& name() const override { return name_; }
   void initialise(const fem::ContactSetup& setup) override;
+  double estimated_bytes(const fem::Mesh& mesh, bool erosion) const override;
   void add_forces(const double* x, const double* v, const double* mass, double dt, double* f_contact) override;
   double friction_dissipation() const override { return dissipated_; }
   std::int64_t active_contacts() const override { return n_sliding_; }

@@ -35,6 +35,10 @@ class ContactAlgorithm {
   virtual const std::string& name() const = 0;
   /// Builds surfaces, search structures and penalties; throws InputError on bad definitions.
   virtual void initialise(const ContactSetup& setup) = 0;
+  /// Bytes this contact will hold once initialised on `mesh` (one rank's), for the memory
+  /// estimate made before the solver is built (fem/memory_estimate.hpp); `erosion`: elements may
+  /// be eroded (a penalty contact then keeps every face of its hexahedra).
+  virtual double estimated_bytes(const Mesh& mesh, bool erosion) const = 0;
   /// Adds contact forces at positions x (velocities v over the last half step, step dt) into
   /// f_contact [3*n_nodes]. Forces between deformable bodies must sum to zero.
   virtual void add_forces(const double* x, const double* v, const double* mass, double dt,

@@ -307,9 +307,7 @@ void ExplicitSolver::erode_and_choose_step(const CycleArrays& a, Cycle& c) {
   const double dt_erode = model_.time.erosion_step_ratio * dt_initial_;
   // With time.mass_scaling_erode_at_cap, an element at the mass cap is eroded once its step is
   // below the target: looked for whenever the step is.
-  const double cap_dt = model_.time.mass_scaling_erode_at_cap
-                            ? model_.time.mass_scaling_dt * (1 - kMassScalingBelowShare)
-                            : 0.0;
+  const double cap_dt = mass_cap_erosion_step();
   if (dt_erode > 0 || cap_dt > 0 || material_failure_) {
     bool check_steps = false;
     if (dt_erode > 0 || cap_dt > 0) {

@@ -248,6 +248,9 @@ class ExplicitSolver {
   /// Whether an element of this rank at the cap of dynamic mass scaling has its step below
   /// cap_dt (only those are measured; none while no element has reached the cap).
   bool capped_below(const double* x, double cap_dt);
+  /// With time.mass_scaling_erode_at_cap, the step below which an element at the mass cap is
+  /// eroded: the target, less the rounding a scaled element's step sits below it; 0 without.
+  double mass_cap_erosion_step() const;
   /// Erodes every element of the groups that can lose elements whose step at x (times the
   /// safety factor) is below dt_erode or one of whose corners has folded over (corner Jacobian
   /// <= 0); those groups' steps (group_step_) become the stable step of the elements left.

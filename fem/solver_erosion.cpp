@@ -42,14 +42,18 @@ std::string ExplicitSolver::element_position(const StableStep& st, const double*
   return "(unknown position)";
 }
 
+double ExplicitSolver::mass_cap_erosion_step() const {
+  return model_.time.mass_scaling_erode_at_cap
+             ? model_.time.mass_scaling_dt * (1 - kMassScalingBelowShare)
+             : 0.0;
+}
+
 void ExplicitSolver::erode(const double* x, const double* v, double dt_erode, bool check_steps,
                            const std::string& blow_up) {
   const double sf = model_.time.safety_factor;
   // Dynamic mass scaling with time.mass_scaling_erode_at_cap: an element at the cap below the
   // target step cannot be held by mass any more.
-  const double cap_dt = model_.time.mass_scaling_erode_at_cap
-                            ? model_.time.mass_scaling_dt * (1 - kMassScalingBelowShare)
-                            : 0.0;
+  const double cap_dt = mass_cap_erosion_step();
   const double cap_ratio = model_.time.mass_scaling_max_ratio;
   std::vector<std::int32_t> gone;  // mesh-wide element indices
   std::vector<std::int32_t> orphans;

@@ -22,4 +22,14 @@ inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b
 inline double norm(V3 a) { return std::sqrt(dot(a, a)); }
 inline V3 normalized(V3 a) { const double n = norm(a); return n > 0 ? (1.0 / n) * a : V3{}; }
 
+// The same on xyz triples stored in place (a kernel's rows of an interleaved array).
+inline double dot3(const double* a, const double* b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+inline void cross3(const double* a, const double* b, double* c) {
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 }  // namespace ncfsim::fem

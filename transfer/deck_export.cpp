@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fem/elements/element_kind.hpp"
 #include "fem/io/atomic_file.hpp"
 
 namespace ncfsim::transfer {
@@ -13,8 +14,7 @@ namespace ncfsim::transfer {
 namespace {
 
 // Hexahedron faces in VTK corner numbers (0-based), outward, the order ExportTie uses.
-constexpr int kFace[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                             {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+constexpr const auto& kFace = fem::kHex8Faces;
 // Abaqus C3D8 face labels S1..S6 for the same faces (S1: 1-2-3-4, S2: 5-8-7-6, S3: 1-5-6-2,
 // S4: 2-6-7-3, S5: 3-7-8-4, S6: 4-8-5-1).
 constexpr int kAbaqusFace[6] = {1, 2, 3, 4, 5, 6};
@@ -144,8 +144,9 @@ void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& 
       s += fmt::format("*SET_SEGMENT\n{:>10}\n", ids[side]);
       for (auto [e, f] : side == 0 ? t.slave : t.master) {
         const auto& h = m.hex[static_cast<std::size_t>(e)];
-        s += fmt::format("{:>10}{:>10}{:>10}{:>10}\n", h[kFace[f][0]] + 1, h[kFace[f][1]] + 1,
-                         h[kFace[f][2]] + 1, h[kFace[f][3]] + 1);
+        s += fmt::format("{:>10}{:>10}{:>10}{:>10}\n", h[kFace[f].corner[0]] + 1,
+                         h[kFace[f].corner[1]] + 1, h[kFace[f].corner[2]] + 1,
+                         h[kFace[f].corner[3]] + 1);
       }
     }
     s += fmt::format(

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "fem/contact/bucket_grid.hpp"
+#include "fem/elements/element_kind.hpp"
 
 namespace ncfsim::transfer {
 
@@ -16,11 +17,11 @@ using fem::V3;
 
 namespace {
 
-// Natural coordinates of the VTK hexahedron corners and its faces (-z, +z, -y, +x, +y, -x).
+// Natural coordinates of the VTK hexahedron corners; its faces (-z, +z, -y, +x, +y, -x) are the
+// engine's.
 constexpr double kXi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
                               {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
-constexpr int kFace[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                             {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+constexpr const auto& kFace = fem::kHex8Faces;
 
 // d(position)/d(natural coordinate) at the element centre, columns xi, eta, zeta.
 Eigen::Matrix3d centre_jacobian(const std::array<V3, 8>& x) {
@@ -85,8 +86,9 @@ double thinnest_tow(const ImpregnatedModel& m, const std::vector<V3>& x) {
   for (const auto& h : m.hex) {
     V3 bottom, top;
     for (std::size_t k = 0; k < 4; ++k)
-      bottom += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[0][k])])],
-          top += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[1][k])])];
+      bottom += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[0].corner[k])])],
+          top +=
+          0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[1].corner[k])])];
     thinnest = std::min(thinnest, norm(top - bottom));
   }
   return thinnest;
@@ -101,7 +103,8 @@ std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>
   for (std::size_t e = 0; e < m.hex.size(); ++e)
     for (int f = 0; f < 6; ++f) {
       std::array<std::int32_t, 4> key{};
-      for (std::size_t k = 0; k < 4; ++k) key[k] = m.hex[e][static_cast<std::size_t>(kFace[f][k])];
+      for (std::size_t k = 0; k < 4; ++k)
+        key[k] = m.hex[e][static_cast<std::size_t>(kFace[f].corner[k])];
       std::sort(key.begin(), key.end());
       ++count[key];
       face_of[key] = {static_cast<std::int32_t>(e), f};
@@ -113,7 +116,7 @@ std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>
     std::array<V3, 4> c;
     for (std::size_t k = 0; k < 4; ++k)
       c[k] = x[static_cast<std::size_t>(
-          m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(kFace[f][k])])];
+          m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(kFace[f].corner[k])])];
     const V3 centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
     const V3 normal = normalized(cross(c[2] - c[0], c[3] - c[1]));  // outward for VTK face order
     double radius = 0;

@@ -7,7 +7,9 @@
 namespace ncfsim::fem {
 
 /// Bytes an explicit model holds (nodal state vectors, element state, contact surfaces), per
-/// node, hexahedron and bar: an upper estimate from the engine's arrays (docs/case-file.md).
+/// node, hexahedron and bar: a rough bound for the guard below, before anything is meshed. The
+/// estimate a run checks, by element kind, contact, tool and output, is estimate_memory
+/// (fem/memory_estimate.hpp), made once the whole case is read.
 double estimated_model_bytes(double n_nodes, double n_hex, double n_bars);
 
 /// Memory available to this process now (MemAvailable of /proc/meminfo; the physical memory when

@@ -154,4 +154,52 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
   return s;
 }
 
+ContactSurfaceSize contact_surface_size(const Mesh& mesh, const std::vector<ContactGroup>& groups,
+                                        bool interior_faces) {
+  ContactSurfaceSize out;
+  const std::size_t n_parts = mesh.part_names.size();
+  std::vector<std::array<std::int32_t, 4>> keys;
+  std::vector<char> on_group(mesh.n_nodes()), on_outer(mesh.n_nodes());
+  for (const auto& g : groups) {
+    std::vector<char> in_group(n_parts, 0);
+    for (int p : g.parts)
+      if (p >= 0 && static_cast<std::size_t>(p) < n_parts)
+        in_group[static_cast<std::size_t>(p)] = 1;
+    keys.clear();
+    std::fill(on_group.begin(), on_group.end(), 0);
+    std::fill(on_outer.begin(), on_outer.end(), 0);
+    for (const ElementSet& set : mesh.sets) {
+      const auto faces = element_faces(set.kind);
+      if (faces.empty()) continue;
+      for (std::size_t e = 0; e < set.size(); ++e) {
+        if (!in_group[static_cast<std::size_t>(set.part[e])]) continue;
+        const auto nodes = set.nodes(e);
+        for (const auto& f : faces) {
+          std::array<std::int32_t, 4> k{};
+          for (std::size_t c = 0; c < 4; ++c) k[c] = nodes[static_cast<std::size_t>(f.corner[c])];
+          std::sort(k.begin(), k.end());
+          keys.push_back(k);
+        }
+      }
+    }
+    std::sort(keys.begin(), keys.end());
+    for (std::size_t i = 0; i < keys.size();) {
+      std::size_t j = i + 1;
+      while (j < keys.size() && keys[j] == keys[i]) ++j;
+      const bool outer = j - i == 1;
+      if (outer || (interior_faces && j - i == 2)) {
+        out.segments += static_cast<double>(j - i);
+        for (auto nd : keys[i]) {
+          on_group[static_cast<std::size_t>(nd)] = 1;
+          if (outer) on_outer[static_cast<std::size_t>(nd)] = 1;
+        }
+      }
+      i = j;
+    }
+    out.nodes += static_cast<double>(std::count(on_group.begin(), on_group.end(), 1));
+    out.outer_nodes += static_cast<double>(std::count(on_outer.begin(), on_outer.end(), 1));
+  }
+  return out;
+}
+
 }  // namespace ncfsim::fem

@@ -35,6 +35,15 @@ struct ContactSurface {
   std::size_t n_nodes() const { return node.size(); }
 };
 
+/// How large extract_contact_surface's result for these groups will be, counted without building
+/// it (the memory estimate): segments, surface nodes, and the nodes on outer faces (the ones that
+/// get facets). Part indices outside the mesh are skipped (extract_contact_surface reports them).
+struct ContactSurfaceSize {
+  double segments = 0, nodes = 0, outer_nodes = 0;
+};
+ContactSurfaceSize contact_surface_size(const Mesh& mesh, const std::vector<ContactGroup>& groups,
+                                        bool interior_faces);
+
 /// Outer faces of each group (faces used by exactly one hexahedron of the group's parts). With
 /// `interior_faces`, also each face shared by two hexahedra of a group, once from each side (as
 /// the outer face of one, covered by the other), and their nodes: what erosion may uncover.

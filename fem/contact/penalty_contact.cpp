@@ -26,6 +26,20 @@ PenaltyContact::PenaltyContact(PenaltyContactConfig config) : cfg_(std::move(con
   validate(cfg_);
 }
 
+// Counted from the arrays below (docs/performance.md, "Memory"): per surface node its sorted
+// position, facets, force slot; per facet (nodes on outer faces, ~1.5 each) the friction states
+// and best hit; the candidates (~2 a node, kept at their largest); the nodal masses over the mesh.
+// Per segment the arrays hold ~370 bytes (records, frame, box, depth, adjacency, grid share), but
+// a dormant inner face (erosion) never touches most of them: 180 is what the hemispheres' resident
+// sets after set-up show (CI, coarse, paper density; docs/performance.md).
+double PenaltyContact::estimated_bytes(const Mesh& mesh, bool erosion) const {
+  const ContactSurfaceSize sz = contact_surface_size(mesh, cfg_.groups, erosion);
+  constexpr double kPerSegment = 180, kPerNode = 145, kPerFacet = 140, kPerCandidate = 34;
+  return kPerSegment * sz.segments + kPerNode * sz.nodes +
+         (1.5 * kPerFacet + 2 * kPerCandidate) * sz.outer_nodes +
+         8.0 * static_cast<double>(mesh.n_nodes());
+}
+
 void PenaltyContact::initialise(const ContactSetup& setup) {
   const std::string prefix = "contact." + cfg_.name;
   if (!setup.mesh || !setup.x0 || !setup.mass || !(setup.dt > 0))

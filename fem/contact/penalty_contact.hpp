@@ -82,6 +82,7 @@ class PenaltyContact final : public ContactAlgorithm {
 
   const std::string& name() const override { return cfg_.name; }
   void initialise(const ContactSetup& setup) override;
+  double estimated_bytes(const Mesh& mesh, bool erosion) const override;
   void add_forces(const double* x, const double* v, const double* mass, double dt,
                   double* f_contact) override;
   double friction_dissipation() const override { return dissipation_; }

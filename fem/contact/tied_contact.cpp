@@ -169,6 +169,23 @@ void TiedContact::initialise_face_pairs(const ContactSetup& setup) {
   }
 }
 
+// Per tie (a slave node) ~200 bytes of state, with push_back slack ~300; the master surface is
+// built for the set-up only (records, frames, grid: ~250 bytes a segment); face pairs also take
+// two arrays over the mesh's nodes while they are matched.
+double TiedContact::estimated_bytes(const Mesh& mesh, bool erosion) const {
+  (void)erosion;
+  constexpr double kPerTie = 300, kPerMasterSegment = 250;
+  if (!cfg_.face_pairs.empty())
+    return kPerTie * static_cast<double>(cfg_.face_pairs.size()) +
+           12.0 * static_cast<double>(mesh.n_nodes()) +
+           kPerMasterSegment * static_cast<double>(cfg_.face_pairs.size());
+  const ContactSurfaceSize master = contact_surface_size(mesh, {cfg_.master}, false);
+  const double ties = cfg_.slave_nodes.empty()
+                          ? contact_surface_size(mesh, {cfg_.slave}, false).nodes
+                          : static_cast<double>(cfg_.slave_nodes.size());
+  return kPerTie * ties + kPerMasterSegment * master.segments;
+}
+
 void TiedContact::initialise(const ContactSetup& setup) {
   const std::string prefix = "contact." + cfg_.name;
   if (!setup.mesh || !setup.x0 || !setup.mass || !(setup.dt > 0))

@@ -13,6 +13,7 @@
 #include "fem/elements/hex8_basis.hpp"
 #include "fem/elements/simd_batch.hpp"
 #include "fem/errors.hpp"
+#include "fem/vec3.hpp"
 
 namespace ncfsim::fem {
 namespace stdx = std::experimental;
@@ -22,16 +23,7 @@ constexpr int CH = static_cast<int>(kHex8Chunk);  // elements per chunk: the chu
 
 constexpr const auto& S = kHex8Sign;
 
-struct Vec3 {
-  double x, y, z;
-};
-inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator*(double s, Vec3 a) { return {s * a.x, s * a.y, s * a.z}; }
-inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Vec3 cross(Vec3 a, Vec3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
+using Vec3 = V3;  // the scalar paths (set-up, steps, checks); the kernel has its SIMD V3v below
 
 // Geometry of one element from its 8 nodes: basis vectors a_k (k=1..7), volume derivative vectors
 // d_k (k=1..6) with b_I = sum_k S[k][I] d_k / V, and the volume.
@@ -78,10 +70,9 @@ inline void hex_frame(const HexGeometry& g, double R[9], double l[3]) {
 }
 
 inline double max_face_area_sq(const Vec3 x[8]) {
-  constexpr int F[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                           {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
   double m = 0;
-  for (const auto& f : F) {
+  for (const auto& face : kHex8Faces) {
+    const auto& f = face.corner;
     const Vec3 c = cross(x[f[2]] - x[f[0]], x[f[3]] - x[f[1]]);
     m = std::max(m, 0.25 * dot(c, c));
   }
@@ -606,9 +597,8 @@ void hex8_internal_forces(Hex8Block& b, const double* x, const double* v, double
       // Largest face area (stable step), from the nodes before they are transformed.
       VD amax_sq = 0.0;
       {
-        constexpr int F[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                                 {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-        for (const auto& fc : F) {
+        for (const auto& face : kHex8Faces) {
+          const auto& fc = face.corner;
           const V3v d1{xu[0][fc[2]] - xu[0][fc[0]], xu[1][fc[2]] - xu[1][fc[0]],
                        xu[2][fc[2]] - xu[2][fc[0]]};
           const V3v d2{xu[0][fc[3]] - xu[0][fc[1]], xu[1][fc[3]] - xu[1][fc[1]],

@@ -196,6 +196,9 @@ class WithoutTravelBound final : public fem::ContactAlgorithm {
   explicit WithoutTravelBound(std::unique_ptr<fem::ContactAlgorithm> c) : c_(std::move(c)) {}
   const std::string& name() const override { return c_->name(); }
   void initialise(const fem::ContactSetup& setup) override { c_->initialise(setup); }
+  double estimated_bytes(const fem::Mesh& mesh, bool erosion) const override {
+    return c_->estimated_bytes(mesh, erosion);
+  }
   void add_forces(const double* x, const double* v, const double* m, double dt,
                   double* f) override {
     c_->add_forces(x, v, m, dt, f);

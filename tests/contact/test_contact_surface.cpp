@@ -58,6 +58,28 @@ TEST(ContactSurface, FacesBetweenGroupsBelongToBothSurfaces) {
   EXPECT_EQ(s.n_nodes(), 2u * (3u * 5u * 5u - 1u * 3u * 3u));
 }
 
+// The memory estimate counts a surface without building it (contact_surface_size): the same
+// segments and surface nodes as extract_contact_surface, with and without the inner faces that
+// erosion may uncover, for one group and for two.
+TEST(ContactSurface, SizeCountedWithoutBuildingMatchesTheBuiltSurface) {
+  const fem::Mesh m = two_part_block(4);
+  for (const bool interior : {false, true})
+    for (const std::vector<fem::ContactGroup>& groups :
+         {std::vector<fem::ContactGroup>{{"all", {0, 1}}},
+          std::vector<fem::ContactGroup>{{"left", {0}}, {"right", {1}}}}) {
+      const auto built =
+          fem::extract_contact_surface(m, groups, m.coords.data(), "", "contact.t", interior);
+      const auto size = fem::contact_surface_size(m, groups, interior);
+      EXPECT_EQ(size.segments, static_cast<double>(built.n_segments()))
+          << groups.size() << " groups, inner faces " << interior;
+      EXPECT_EQ(size.nodes, static_cast<double>(built.n_nodes()))
+          << groups.size() << " groups, inner faces " << interior;
+    }
+  // Inner faces once from each side: 6 n^2 outer + 2 * 3 n^2 (n - 1) inner for n = 4.
+  EXPECT_EQ(fem::contact_surface_size(m, {{"all", {0, 1}}}, true).segments,
+            6.0 * 16 + 2.0 * 3 * 16 * 3);
+}
+
 TEST(ContactSurface, SegmentProjectionIsExactOnAParallelogram) {
   const double p[4][3] = {{0, 0, 0}, {2, 0, 0}, {3, 1, 0}, {1, 1, 0}};
   fem::SegmentFrame f;

@@ -27,6 +27,7 @@
 #include <unordered_map>
 
 #include "drape/kinematic_drape.hpp"
+#include "fem/elements/element_kind.hpp"
 #include "fem/errors.hpp"
 
 namespace ncfsim::workflow {
@@ -377,8 +378,6 @@ ImportedRing import_vtu(const fs::path& file, const RingImportOptions& opt) {
 
   // The surface: 2D cells, and the faces of 3D cells that no other 3D cell shares. With a cell
   // field only the cells with a finite value take part (a meso frame: the plies' tows).
-  static constexpr int kHexFace[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                                         {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
   std::vector<Tri> tri;
   std::map<std::vector<std::int32_t>, std::pair<int, std::vector<std::int32_t>>> faces;
   // Cell values summed at the points: of the surface's cells (2D, 3D), and of vertex cells (a
@@ -420,10 +419,12 @@ ImportedRing import_vtu(const fs::path& file, const RingImportOptions& opt) {
     } else if (dim == 3) {
       std::vector<std::vector<std::int32_t>> cf;
       if (cell->GetCellType() == VTK_HEXAHEDRON) {
-        for (const auto& hf : kHexFace)
+        for (const auto& face : fem::kHex8Faces) {
+          const auto& hf = face.corner;
           cf.push_back({ids[static_cast<std::size_t>(hf[0])], ids[static_cast<std::size_t>(hf[1])],
                         ids[static_cast<std::size_t>(hf[2])],
                         ids[static_cast<std::size_t>(hf[3])]});
+        }
       } else {
         for (int k = 0; k < cell->GetNumberOfFaces(); ++k) {
           vtkCell* face = cell->GetFace(k);

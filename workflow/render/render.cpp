@@ -62,6 +62,7 @@
 #include <system_error>
 #include <unordered_map>
 
+#include "fem/elements/element_kind.hpp"
 #include "gl_context.hpp"
 
 // Defined in glew_shim.cpp. Referencing the marker makes the linker pull the shim's object file
@@ -498,8 +499,7 @@ struct BoundaryQuads {
 };
 
 BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8) {
-  static constexpr int kFaces[6][4] = {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4},
-                                       {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}};
+  constexpr const auto& kFaces = fem::kHex8Faces;
   struct Key {
     std::array<std::int64_t, 4> sorted;
     bool operator==(const Key& o) const { return sorted == o.sorted; }
@@ -521,7 +521,7 @@ BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8) {
     for (int f = 0; f < 6; ++f) {
       Key key;
       for (int k = 0; k < 4; ++k) {
-        key.sorted[k] = hex8[8 * e + kFaces[f][k]];
+        key.sorted[k] = hex8[8 * e + kFaces[f].corner[k]];
       }
       std::sort(key.sorted.begin(), key.sorted.end());
       auto [it, inserted] = seen.try_emplace(key, 6 * e + f, 0);
@@ -542,7 +542,7 @@ BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8) {
     const std::size_t e = id / 6;
     const int f = static_cast<int>(id % 6);
     for (int k = 0; k < 4; ++k) {
-      out.nodes.push_back(static_cast<vtkIdType>(hex8[8 * e + kFaces[f][k]]));
+      out.nodes.push_back(static_cast<vtkIdType>(hex8[8 * e + kFaces[f].corner[k]]));
     }
     out.hex.push_back(e);
   }

@@ -21,6 +21,7 @@
 #include "fem/errors.hpp"
 #include "fem/io/hdf5_checkpoint.hpp"
 #include "fem/io/result_writers.hpp"
+#include "fem/memory_estimate.hpp"
 #include "fem/parallel/domain.hpp"
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
@@ -213,10 +214,7 @@ double thread_cpu_seconds() {
 }
 
 // The process's largest resident set so far (what a user sizes a machine by), MB.
-double peak_memory_mb() {
-  rusage u{};
-  return getrusage(RUSAGE_SELF, &u) == 0 ? static_cast<double>(u.ru_maxrss) / 1024.0 : 0.0;
-}
+double peak_memory_mb() { return fem::peak_resident_mb(); }
 
 void log_start(const Run& r) {
   r.log->info("ncfsim {} | case '{}' ({}) | resolution {}", kVersion, r.ec.name, r.ec.file.string(),
@@ -855,7 +853,12 @@ int finish_run(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHi
     for (const auto& f : m->write_files(solver, r.dir))
       r.log->info("wrote {}", (r.dir / f).string());
   log_end(r, solver);
-  if (!StopRequest::requested()) draw_figures_and_report(r);
+  if (!StopRequest::requested()) {
+    draw_figures_and_report(r);
+    // The figures are drawn in this process: its peak counts them.
+    r.summary["peak_memory_MB"] = peak_memory_mb();
+    r.write_summary();
+  }
   if (StopRequest::requested() && r.status == "completed") {
     // Ctrl-C after the last cycle: the results are complete, the figures are not all drawn.
     r.status = "interrupted";
@@ -905,7 +908,12 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   fem::CheckpointTree checkpoint;
   std::optional<OutputFolder> folder;
   std::int64_t cycle = 0;
+  const fem::MemoryEstimate memory = fem::estimate_memory(
+      ec.model, fem::PetscSession::size(),
+      {ec.output.xdmf || ec.output.vtu, ec.output.vtu, ec.output.figures, true});
   try {
+    // A model too large for the machine is bad input, refused before anything is written.
+    fem::require_memory_fits(memory, ec.file.string());
     if (options.resume && options.overwrite)
       throw InputError(ec.file.string(), "--resume",
                        "continues a run in its own folder: --overwrite does not go with it");
@@ -933,6 +941,9 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   const auto solver_ptr = make_solver(ec, r);
   fem::ExplicitSolver& solver = *solver_ptr;
   describe_model(solver, *r.log, r.summary);
+  r.log->info("memory: {:.0f} MB resident after the set-up; estimated {}", fem::resident_mb(),
+              memory.describe());
+  r.summary["memory_estimate_MB"] = memory.per_rank() / 1e6;
   MeasureList measures = make_run_measures(ec, solver);
   for (const auto& m : measures)
     for (const auto& line : m->setup_lines()) r.log->info("{}", line);

@@ -8,6 +8,7 @@
 #include "fem/case/model_size.hpp"
 #include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
+#include "fem/memory_estimate.hpp"
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
 #include "workflow/run/run_summary.hpp"
@@ -34,17 +35,15 @@ int check_engine_stage(const StageCall& call) {
   // Building the solver checks what only the assembled model can show (massless nodes, steps).
   fem::PetscSession petsc;
   if (const int code = refuse_many_ranks()) return code;
+  const fem::MemoryEstimate memory = fem::estimate_memory(
+      ec.model, 1, {ec.output.xdmf || ec.output.vtu, ec.output.vtu, ec.output.figures, true});
   fem::ExplicitSolver probe(ec.model);
-  const double bytes =
-      fem::estimated_model_bytes(static_cast<double>(ec.model.mesh.n_nodes()),
-                                 static_cast<double>(probe.n_elements(fem::ElementKind::Hex8)),
-                                 static_cast<double>(probe.n_elements(fem::ElementKind::Bar2)));
   std::printf(
-      "%s: OK (case '%s', %zu nodes, %s, stable step %.4g s, about %.3g cycles, about %s of "
-      "memory of %s available)\n",
+      "%s: OK (case '%s', %zu nodes, %s, stable step %.4g s, about %.3g cycles; memory %s of %s "
+      "available)\n",
       call.case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(),
       element_counts(probe).c_str(), probe.time_step(), ec.model.time.end_time / probe.time_step(),
-      fem::bytes_text(bytes).c_str(), fem::bytes_text(fem::available_memory_bytes()).c_str());
+      memory.describe().c_str(), fem::bytes_text(fem::available_memory_bytes()).c_str());
   return kSuccess;
 }
 

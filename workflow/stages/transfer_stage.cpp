@@ -12,6 +12,7 @@
 #include "fem/errors.hpp"
 #include "fem/io/result_writers.hpp"
 #include "fem/io/stage_handoff.hpp"
+#include "fem/memory_estimate.hpp"
 #include "transfer/case/transfer_case.hpp"
 #include "workflow/figures/figures.hpp"
 #include "workflow/output/output_files.hpp"
@@ -34,6 +35,27 @@ fem::io::StageFrame read_source(const transfer::TransferCase& tc) {
   } catch (const std::runtime_error& e) {
     throw InputError(file, "source.results", e.what());
   }
+}
+
+// What a transfer holds, from its source frame's size (docs/performance.md, "Memory"): the frame
+// read (the drape's mesh, positions, nodal and cell fields), the impregnated model (frames,
+// classes) with the tie search's face maps (~1.1 kB per mapped hexahedron; 600 B per source
+// hexahedron, as a dome is trimmed out of its blank), the result writer's mesh, the figures
+// (measured: 185 MB, as a run's).
+fem::MemoryEstimate transfer_memory(const fem::io::StageFrame& frame, bool figures) {
+  constexpr double kProgram = 64e6, kFigures = 185e6;
+  constexpr double kFramePerNode = 32 + 24 + 48, kFramePerCell = 88 + 200;
+  constexpr double kModelPerHex = 600, kWriterPerNode = 32, kWriterPerHex = 88;
+  const double nodes = static_cast<double>(frame.n_points());
+  const double hex = static_cast<double>(frame.mesh.hex8.size() / 8);
+  const double cells = hex + static_cast<double>(frame.mesh.bar2.size() / 2);
+  fem::MemoryEstimate est;
+  est.shares.push_back({"program", kProgram});
+  est.shares.push_back({"source frame", kFramePerNode * nodes + kFramePerCell * cells});
+  est.shares.push_back({"impregnated model and ties", kModelPerHex * hex});
+  est.shares.push_back(
+      {"output", kWriterPerNode * nodes + kWriterPerHex * hex + (figures ? kFigures : 0.0)});
+  return est;
 }
 
 ImpregnatedModel build(transfer::TransferCase& tc, const fem::io::StageFrame& frame) {
@@ -243,6 +265,8 @@ int run_transfer_stage(const StageCall& call) {
   const auto t0 = std::chrono::steady_clock::now();
   auto tc = transfer::load_transfer_case(call.case_file, call.overrides);
   const auto frame = read_source(tc);
+  const fem::MemoryEstimate memory = transfer_memory(frame, tc.figures && tc.frames_xdmf);
+  fem::require_memory_fits(memory, tc.file.string());
   const ImpregnatedModel m = build(tc, frame);
 
   const std::filesystem::path dir = output_folder(tc.name, call.options);
@@ -253,6 +277,8 @@ int run_transfer_stage(const StageCall& call) {
   for (const auto& o : call.overrides) log->info("  --set {}", o);
   log->info("drape result {}: frame {} of {} at t = {:.6g} s", tc.results.string(), frame.index + 1,
             frame.n_frames, frame.time);
+  log->info("memory: {:.0f} MB resident with the model built; estimated {}", fem::resident_mb(),
+            memory.describe());
   double vf_min = 1, vf_max = 0, vf_sum = 0;
   for (double vf : m.vf) vf_min = std::min(vf_min, vf), vf_max = std::max(vf_max, vf), vf_sum += vf;
   const double vf_mean = vf_sum / static_cast<double>(m.vf.size());
@@ -309,8 +335,14 @@ int run_transfer_stage(const StageCall& call) {
   s["stitches_dropped"] = m.n_stitches - m.stitch.size();
   s["compressive_ratio"] = tc.spec.compressive_ratio;
   s["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s["memory_estimate_MB"] = memory.per_rank() / 1e6;
+  s["peak_memory_MB"] = fem::peak_resident_mb();
   write_file_atomically(dir / "summary.json", s.dump(2) + "\n");
-  if (tc.figures && tc.frames_xdmf) write_figures(dir, tc.name, *log);
+  if (tc.figures && tc.frames_xdmf) {
+    write_figures(dir, tc.name, *log);
+    s["peak_memory_MB"] = fem::peak_resident_mb();  // the figures are drawn in this process
+    write_file_atomically(dir / "summary.json", s.dump(2) + "\n");
+  }
   try {
     write_report(dir);
   } catch (const std::exception& e) {

@@ -1,0 +1,167 @@
+#include "fem/memory_estimate.hpp"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "fem/case/model_size.hpp"
+#include "fem/contact_interface.hpp"
+#include "fem/errors.hpp"
+#include "fem/model.hpp"
+
+namespace ncfsim::fem {
+
+namespace {
+
+// Bytes per unit, counted from the engine's arrays (docs/performance.md, "Memory", lists them).
+// Measured, not counted: the program's own resident set, and what the run adds after its set-up
+// when it draws its figures in this process (VTK, OSMesa, the results read back; the contact's
+// growth over the run and the frames are inside it): 185 MB and 490 B per node and 1.77 kB per
+// hexahedron, fitted to the CI, coarse and paper-density hemispheres (1 rank, 6 December 2026).
+constexpr double kProgram = 64e6;           // libraries (PETSc, MPI, HDF5, VTK), one rank
+constexpr double kPerNode = 323;            // 9 PETSc nodal vectors, solver masks, mesh coordinates
+constexpr double kPerNodeErosion = 5;       // node-to-element map, freed flags
+constexpr double kPerNodeDynamicMass = 24;  // the mass-scaling scratch
+constexpr double kPerNodeShellGroup = 59;   // each shell group's rotational arrays (all nodes)
+constexpr double kPerNodeParallel = 64;     // ownership, halo positions, star-forest buffers
+constexpr double kHexFixed = 48 + 52 + 16;  // integers of the block and the mesh, anisotropy
+constexpr double kHexDoubles = 75;          // stress, strain, hourglass, frames, volumes, ...
+constexpr double kHexOwnAxes = 76;          // per-element axes and material (a formed part)
+constexpr double kPerBar = 88;
+constexpr double kShellFixed = 32 + 36, kShellDoubles = 41;
+constexpr double kToolPerNode = 56;       // contact node, friction state, proximity reference
+constexpr double kToolPerTriangle = 120;  // STL tools: triangles, normals, buckets
+constexpr double kSetupPerElement = 24;   // renumbering keys, sort buffers (set-up, kept by malloc)
+
+// Output on the root: each result writer's copy of the mesh, then the largest of one frame in the
+// making (all cell arrays are sized to every cell), the checkpoint's copy of the state, and the
+// figures drawn at the end (measured, above).
+constexpr double kWriterPerNode = 32, kWriterPerHex = 88, kWriterPerBar = 32, kWriterPerQuad = 56;
+constexpr double kFramePerCell = 200, kFramePerNode = 72, kVtuPerNode = 72, kVtuPerHex = 77;
+constexpr double kCheckpointPerNode = 72, kCheckpointPerHex = 8 * 38;
+constexpr double kFigures = 185e6, kFiguresPerNode = 490, kFiguresPerHex = 1770;
+
+double n_of(const Mesh& m, ElementKind k) { return static_cast<double>(m.elements(k).size()); }
+
+}  // namespace
+
+double MemoryEstimate::per_rank() const {
+  double s = 0;
+  for (const auto& sh : shares) s += sh.bytes;
+  return s;
+}
+
+std::string MemoryEstimate::describe() const {
+  std::ostringstream os;
+  os << "about " << bytes_text(per_rank()) << (ranks > 1 ? " a rank" : "") << " (";
+  bool first = true;
+  for (const auto& sh : shares) {
+    if (sh.bytes < 0.5e6) continue;
+    os << (first ? "" : ", ") << sh.what << " " << std::lround(sh.bytes / 1e6);
+    first = false;
+  }
+  os << " MB)";
+  if (ranks > 1) os << ", " << bytes_text(total()) << " on " << ranks << " ranks";
+  return os.str();
+}
+
+MemoryEstimate estimate_memory(const Model& model, int ranks, const OutputMemory& output) {
+  const Mesh& mesh = model.mesh;
+  MemoryEstimate est;
+  est.ranks = std::max(1, ranks);
+  const double nodes = static_cast<double>(mesh.n_nodes());
+  const double n_hex = n_of(mesh, ElementKind::Hex8), n_bar = n_of(mesh, ElementKind::Bar2),
+               n_quad = n_of(mesh, ElementKind::Quad4);
+  bool material_failure = false;
+  for (const auto& m : model.materials) material_failure |= m->failure_history_row() >= 0;
+  const bool erosion =
+      model.time.erosion_step_ratio > 0 || model.time.mass_scaling_erode_at_cap || material_failure;
+
+  est.shares.push_back({"program", kProgram});
+  // Nodes: each shell part is a group of its own with arrays over every node of the model.
+  std::vector<char> shell_part(mesh.part_names.size(), 0);
+  for (auto p : mesh.elements(ElementKind::Quad4).part) shell_part[static_cast<std::size_t>(p)] = 1;
+  const double shell_groups =
+      static_cast<double>(std::count(shell_part.begin(), shell_part.end(), 1));
+  double per_node = kPerNode + (erosion ? kPerNodeErosion : 0) +
+                    (model.time.mass_scaling_dynamic ? kPerNodeDynamicMass : 0) +
+                    kPerNodeShellGroup * shell_groups + (est.ranks > 1 ? kPerNodeParallel : 0);
+  est.shares.push_back({"nodes", per_node * nodes});
+
+  // Hexahedra: the block's doubles grow with the material law's history.
+  if (n_hex > 0) {
+    const ElementSet& hex = mesh.elements(ElementKind::Hex8);
+    double bytes = 0;
+    for (std::size_t e = 0; e < hex.size(); ++e) {
+      int mat = hex.material.empty() ? -1 : hex.material[e];
+      if (mat < 0) mat = model.parts[static_cast<std::size_t>(hex.part[e])].material;
+      const int nh = mat >= 0 && static_cast<std::size_t>(mat) < model.materials.size()
+                         ? model.materials[static_cast<std::size_t>(mat)]->n_history()
+                         : 0;
+      bytes += kHexFixed + 8 * (kHexDoubles + nh);
+    }
+    if (!hex.material_axes.empty()) bytes += kHexOwnAxes * n_hex;
+    est.shares.push_back({"hexahedra", bytes});
+  }
+  if (n_bar > 0) est.shares.push_back({"bars", kPerBar * n_bar});
+  if (n_quad > 0) est.shares.push_back({"shells", (kShellFixed + 8 * kShellDoubles) * n_quad});
+  est.shares.push_back({"set-up", kSetupPerElement * (n_hex + n_bar + n_quad)});
+
+  for (const auto& c : model.contacts)
+    est.shares.push_back({"contact '" + c->name() + "'", c->estimated_bytes(mesh, erosion)});
+  double tools = 0;
+  for (const auto& t : model.tools) {
+    tools += kToolPerNode * static_cast<double>(t.contact_nodes.size());
+    if (t.surface.triangles)
+      tools += kToolPerTriangle * static_cast<double>(t.surface.triangles->triangles().size());
+  }
+  if (tools > 0) est.shares.push_back({"tools", tools});
+
+  // The root's output: writers' meshes, then the largest of a frame, a checkpoint, the figures.
+  const double cells = n_hex + n_bar + n_quad;
+  double out = 0, transient = 0;
+  if (output.frames) {
+    const double writers = output.vtu ? 2.0 : 1.0;
+    out += writers * (kWriterPerNode * nodes + kWriterPerHex * n_hex + kWriterPerBar * n_bar +
+                      kWriterPerQuad * n_quad);
+    if (output.vtu) out += kVtuPerHex * n_hex;
+    transient =
+        kFramePerCell * cells + kFramePerNode * nodes + (output.vtu ? kVtuPerNode * nodes : 0.0);
+  }
+  if (output.checkpoints)
+    transient = std::max(transient, kCheckpointPerNode * nodes + kCheckpointPerHex * n_hex);
+  if (output.figures)
+    transient = std::max(transient, kFigures + kFiguresPerNode * nodes + kFiguresPerHex * n_hex);
+  if (out + transient > 0) est.shares.push_back({"output", out + transient});
+  return est;
+}
+
+double peak_resident_mb() {
+  rusage u{};
+  return getrusage(RUSAGE_SELF, &u) == 0 ? static_cast<double>(u.ru_maxrss) / 1024.0 : 0.0;
+}
+
+double resident_mb() {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
+  return 0.0;
+}
+
+void require_memory_fits(const MemoryEstimate& estimate, const std::string& file) {
+  const double need = estimate.total(), have = available_memory_bytes();
+  if (std::isfinite(need) && need <= 0.8 * have) return;
+  throw InputError(file, "mesh",
+                   "makes a model too large for this machine: it needs " + estimate.describe() +
+                       ", and " + bytes_text(have) +
+                       " of memory is available (at most 80 % of it may be used): use a coarser "
+                       "mesh (mesh.resolution = \"coarse\"), a smaller part, fewer ranks, or a "
+                       "machine with more memory");
+}
+
+}  // namespace ncfsim::fem
