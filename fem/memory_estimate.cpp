@@ -1,15 +1,16 @@
 #include "fem/memory_estimate.hpp"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
-#include "fem/case/model_size.hpp"
 #include "fem/contact_interface.hpp"
 #include "fem/errors.hpp"
 #include "fem/model.hpp"
@@ -138,7 +139,28 @@ MemoryEstimate estimate_memory(const Model& model, int ranks, const OutputMemory
   if (output.figures)
     transient = std::max(transient, kFigures + kFiguresPerNode * nodes + kFiguresPerHex * n_hex);
   if (out + transient > 0) est.shares.push_back({"output", out + transient});
+  est.root_only = out + transient;
   return est;
+}
+
+double available_memory_bytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  double kb = 0;
+  std::string unit;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024.0;
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 1e300;
+}
+
+std::string bytes_text(double bytes) {
+  char buf[64];
+  if (bytes >= 1e9)
+    std::snprintf(buf, sizeof buf, "%.3g GB", bytes / 1e9);
+  else
+    std::snprintf(buf, sizeof buf, "%.3g MB", bytes / 1e6);
+  return buf;
 }
 
 double peak_resident_mb() {

@@ -21,9 +21,12 @@ struct MemoryEstimate {
   };
   std::vector<Share> shares;
   int ranks = 1;
+  double root_only = 0;  // of the shares, what only the root holds (the output), bytes
 
+  /// The root's: the largest of the ranks.
   double per_rank() const;
-  double total() const { return per_rank() * ranks; }
+  /// Every rank the model, the root also the output.
+  double total() const { return per_rank() * ranks - root_only * (ranks - 1); }
   /// "about 880 MB a rank (program 60, nodes 115, hexahedra 93, contact 'fabric' 350, ...)".
   std::string describe() const;
 };
@@ -40,6 +43,13 @@ struct OutputMemory {
 /// The estimate for `model` (as read from its case: mesh, materials, contacts, tools), on `ranks`
 /// ranks, with the root's output.
 MemoryEstimate estimate_memory(const Model& model, int ranks, const OutputMemory& output);
+
+/// Memory available to this process now (MemAvailable of /proc/meminfo; the physical memory when
+/// that cannot be read), bytes.
+double available_memory_bytes();
+
+/// "1.2 GB", "350 MB".
+std::string bytes_text(double bytes);
 
 /// The process's largest resident set so far (getrusage) and its resident set now (VmRSS of
 /// /proc/self/status), MB; 0 where they cannot be read.

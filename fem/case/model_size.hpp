@@ -4,6 +4,8 @@
 // its key, not a std::bad_alloc (or the kernel's OOM killer) minutes later.
 #include <string>
 
+#include "fem/memory_estimate.hpp"  // available_memory_bytes, bytes_text
+
 namespace ncfsim::fem {
 
 /// Bytes an explicit model holds (nodal state vectors, element state, contact surfaces), per
@@ -12,16 +14,9 @@ namespace ncfsim::fem {
 /// (fem/memory_estimate.hpp), made once the whole case is read.
 double estimated_model_bytes(double n_nodes, double n_hex, double n_bars);
 
-/// Memory available to this process now (MemAvailable of /proc/meminfo; the physical memory when
-/// that cannot be read), bytes.
-double available_memory_bytes();
-
 /// Throws InputError(file, key) when a model of the counts given (the whole model so far plus
 /// what `key` adds) would need more than 80 % of the memory available, naming the estimate.
 void require_model_fits(const std::string& file, const std::string& key, double n_nodes,
                         double n_hex, double n_bars);
-
-/// "1.2 GB", "350 MB".
-std::string bytes_text(double bytes);
 
 }  // namespace ncfsim::fem
