@@ -24,6 +24,14 @@ namespace fs = std::filesystem;
 inline const fs::path kExe = NCFSIM_EXE;
 inline const fs::path kSource = NCFSIM_SOURCE_DIR;
 
+/// Built with AddressSanitizer (the asan preset, as ncfsim then is): its resident sets are the
+/// sanitizer's shadow memory and quarantine, not the release build's, so memory checks skip.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kSanitizedBuild = true;
+#else
+inline constexpr bool kSanitizedBuild = false;
+#endif
+
 struct Result {
   int code = -1;
   std::string output;  // stdout + stderr

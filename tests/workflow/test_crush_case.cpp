@@ -77,8 +77,10 @@ TEST(CliCrush, FlatBlanketIsPressedWithItsBalanceForceCurveAndDamage) {
   EXPECT_EQ(s["stage"], "crush");
   EXPECT_LT(s["energy_balance_error"].get<double>(), 0.01);
   // The memory estimate of the crush model (ties, damage history) within 25 % of its peak.
-  EXPECT_NEAR(s["memory_estimate_MB"].get<double>(), s["peak_memory_MB"].get<double>(),
-              0.25 * s["peak_memory_MB"].get<double>());
+  if (!kSanitizedBuild) {
+    EXPECT_NEAR(s["memory_estimate_MB"].get<double>(), s["peak_memory_MB"].get<double>(),
+                0.25 * s["peak_memory_MB"].get<double>());
+  }
   EXPECT_TRUE(s["peak_force_filtered"].get<bool>());
   EXPECT_GT(s["peak_force_N"].get<double>(), 0.0);
   EXPECT_LE(s["peak_force_N"].get<double>(), s["peak_force_raw_N"].get<double>() * (1 + 1e-9));

@@ -55,8 +55,10 @@ TEST(CliTransfer, FlatBlanketMapsEveryTowWithItsFrameVfAndTies) {
   EXPECT_EQ(s["elements_mapped"].get<std::size_t>(), hexes);
   EXPECT_EQ(s["elements_lost"], 0);
   // The memory estimate made from the source frame within 25 % of the measured peak.
-  EXPECT_NEAR(s["memory_estimate_MB"].get<double>(), s["peak_memory_MB"].get<double>(),
-              0.25 * s["peak_memory_MB"].get<double>());
+  if (!kSanitizedBuild) {
+    EXPECT_NEAR(s["memory_estimate_MB"].get<double>(), s["peak_memory_MB"].get<double>(),
+                0.25 * s["peak_memory_MB"].get<double>());
+  }
   EXPECT_NEAR(s["vf_min"].get<double>(), 0.6, 1e-3);
   EXPECT_NEAR(s["vf_max"].get<double>(), 0.6, 1e-3);
   // Every ply-1 tow lies on ply 2 (its top faces tied, less the tow ends at the blanket's edge),
