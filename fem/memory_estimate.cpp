@@ -24,7 +24,6 @@ namespace {
 // when it draws its figures in this process (VTK, OSMesa, the results read back; the contact's
 // growth over the run and the frames are inside it): 185 MB and 490 B per node and 1.77 kB per
 // hexahedron, fitted to the CI, coarse and paper-density hemispheres (1 rank, 6 December 2026).
-constexpr double kProgram = 64e6;           // libraries (PETSc, MPI, HDF5, VTK), one rank
 constexpr double kPerNode = 323;            // 9 PETSc nodal vectors, solver masks, mesh coordinates
 constexpr double kPerNodeErosion = 5;       // node-to-element map, freed flags
 constexpr double kPerNodeDynamicMass = 24;  // the mass-scaling scratch
@@ -45,7 +44,7 @@ constexpr double kSetupPerElement = 24;   // renumbering keys, sort buffers (set
 constexpr double kWriterPerNode = 32, kWriterPerHex = 88, kWriterPerBar = 32, kWriterPerQuad = 56;
 constexpr double kFramePerCell = 200, kFramePerNode = 72, kVtuPerNode = 72, kVtuPerHex = 77;
 constexpr double kCheckpointPerNode = 72, kCheckpointPerHex = 8 * 38;
-constexpr double kFigures = 185e6, kFiguresPerNode = 490, kFiguresPerHex = 1770;
+constexpr double kFiguresPerNode = 490, kFiguresPerHex = 1770;
 
 double n_of(const Mesh& m, ElementKind k) { return static_cast<double>(m.elements(k).size()); }
 
@@ -83,7 +82,7 @@ MemoryEstimate estimate_memory(const Model& model, int ranks, const OutputMemory
   const bool erosion =
       model.time.erosion_step_ratio > 0 || model.time.mass_scaling_erode_at_cap || material_failure;
 
-  est.shares.push_back({"program", kProgram});
+  est.shares.push_back({"program", kProgramBytes});
   // Nodes: each shell part is a group of its own with arrays over every node of the model.
   std::vector<char> shell_part(mesh.part_names.size(), 0);
   for (auto p : mesh.elements(ElementKind::Quad4).part) shell_part[static_cast<std::size_t>(p)] = 1;
@@ -137,7 +136,8 @@ MemoryEstimate estimate_memory(const Model& model, int ranks, const OutputMemory
   if (output.checkpoints)
     transient = std::max(transient, kCheckpointPerNode * nodes + kCheckpointPerHex * n_hex);
   if (output.figures)
-    transient = std::max(transient, kFigures + kFiguresPerNode * nodes + kFiguresPerHex * n_hex);
+    transient =
+        std::max(transient, kFiguresBytes + kFiguresPerNode * nodes + kFiguresPerHex * n_hex);
   if (out + transient > 0) est.shares.push_back({"output", out + transient});
   est.root_only = out + transient;
   return est;

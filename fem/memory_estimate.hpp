@@ -40,6 +40,11 @@ struct OutputMemory {
   bool checkpoints = true;  // checkpoint.h5 (a copy of the state while it is written)
 };
 
+/// What the program itself holds (libraries: PETSc, MPI, HDF5, VTK), one rank, and what drawing
+/// figures in the process adds at the least (VTK, OSMesa), bytes: measured (docs/performance.md).
+inline constexpr double kProgramBytes = 64e6;
+inline constexpr double kFiguresBytes = 185e6;
+
 /// The estimate for `model` (as read from its case: mesh, materials, contacts, tools), on `ranks`
 /// ranks, with the root's output.
 MemoryEstimate estimate_memory(const Model& model, int ranks, const OutputMemory& output);

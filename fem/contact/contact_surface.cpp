@@ -25,6 +25,33 @@ struct FaceRecord {
 
 V3 node_at(const double* x, std::int32_t i) { return V3::at(x + 3 * static_cast<std::size_t>(i)); }
 
+// The faces of group g's elements (group_of_part[part] == g), sorted by their corners: a key
+// found once is an outer face of the group, twice a face between two of its elements.
+void group_faces(const Mesh& mesh, const std::vector<int>& group_of_part, int g,
+                 std::vector<FaceRecord>& faces) {
+  faces.clear();
+  for (std::size_t q = 0; q < mesh.sets.size(); ++q) {
+    const ElementSet& set = mesh.sets[q];
+    const auto kface = element_faces(set.kind);
+    const std::size_t offset = mesh.element_offset(set.kind);
+    for (std::size_t e = 0; e < set.size() && !kface.empty(); ++e) {
+      if (group_of_part[static_cast<std::size_t>(set.part[e])] != g) continue;
+      const auto h = set.nodes(e);
+      for (std::size_t f = 0; f < kface.size(); ++f) {
+        FaceRecord r;
+        for (int k = 0; k < 4; ++k) r.key[k] = h[static_cast<std::size_t>(kface[f].corner[k])];
+        std::sort(r.key.begin(), r.key.end());
+        r.hex = static_cast<std::int32_t>(offset + e);
+        r.face = static_cast<std::int32_t>(f);
+        r.set = static_cast<std::int32_t>(q);
+        r.elem = static_cast<std::int32_t>(e);
+        faces.push_back(r);
+      }
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+}
+
 }  // namespace
 
 ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<ContactGroup>& groups,
@@ -64,27 +91,7 @@ ContactSurface extract_contact_surface(const Mesh& mesh, const std::vector<Conta
   ContactSurface s;
   std::vector<FaceRecord> faces;
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    faces.clear();
-    for (std::size_t q = 0; q < mesh.sets.size(); ++q) {
-      const ElementSet& set = mesh.sets[q];
-      const auto kface = element_faces(set.kind);
-      const std::size_t offset = mesh.element_offset(set.kind);
-      for (std::size_t e = 0; e < set.size() && !kface.empty(); ++e) {
-        if (group_of_part[static_cast<std::size_t>(set.part[e])] != static_cast<int>(g)) continue;
-        const auto h = set.nodes(e);
-        for (std::size_t f = 0; f < kface.size(); ++f) {
-          FaceRecord r;
-          for (int k = 0; k < 4; ++k) r.key[k] = h[static_cast<std::size_t>(kface[f].corner[k])];
-          std::sort(r.key.begin(), r.key.end());
-          r.hex = static_cast<std::int32_t>(offset + e);
-          r.face = static_cast<std::int32_t>(f);
-          r.set = static_cast<std::int32_t>(q);
-          r.elem = static_cast<std::int32_t>(e);
-          faces.push_back(r);
-        }
-      }
-    }
-    std::sort(faces.begin(), faces.end());
+    group_faces(mesh, group_of_part, static_cast<int>(g), faces);
     for (std::size_t i = 0; i < faces.size();) {
       std::size_t j = i + 1;
       while (j < faces.size() && faces[j].key == faces[i].key) ++j;
@@ -158,38 +165,23 @@ ContactSurfaceSize contact_surface_size(const Mesh& mesh, const std::vector<Cont
                                         bool interior_faces) {
   ContactSurfaceSize out;
   const std::size_t n_parts = mesh.part_names.size();
-  std::vector<std::array<std::int32_t, 4>> keys;
+  std::vector<FaceRecord> faces;
   std::vector<char> on_group(mesh.n_nodes()), on_outer(mesh.n_nodes());
   for (const auto& g : groups) {
-    std::vector<char> in_group(n_parts, 0);
+    std::vector<int> group_of_part(n_parts, -1);  // this group alone: 0
     for (int p : g.parts)
       if (p >= 0 && static_cast<std::size_t>(p) < n_parts)
-        in_group[static_cast<std::size_t>(p)] = 1;
-    keys.clear();
+        group_of_part[static_cast<std::size_t>(p)] = 0;
+    group_faces(mesh, group_of_part, 0, faces);
     std::fill(on_group.begin(), on_group.end(), 0);
     std::fill(on_outer.begin(), on_outer.end(), 0);
-    for (const ElementSet& set : mesh.sets) {
-      const auto faces = element_faces(set.kind);
-      if (faces.empty()) continue;
-      for (std::size_t e = 0; e < set.size(); ++e) {
-        if (!in_group[static_cast<std::size_t>(set.part[e])]) continue;
-        const auto nodes = set.nodes(e);
-        for (const auto& f : faces) {
-          std::array<std::int32_t, 4> k{};
-          for (std::size_t c = 0; c < 4; ++c) k[c] = nodes[static_cast<std::size_t>(f.corner[c])];
-          std::sort(k.begin(), k.end());
-          keys.push_back(k);
-        }
-      }
-    }
-    std::sort(keys.begin(), keys.end());
-    for (std::size_t i = 0; i < keys.size();) {
+    for (std::size_t i = 0; i < faces.size();) {
       std::size_t j = i + 1;
-      while (j < keys.size() && keys[j] == keys[i]) ++j;
+      while (j < faces.size() && faces[j].key == faces[i].key) ++j;
       const bool outer = j - i == 1;
       if (outer || (interior_faces && j - i == 2)) {
         out.segments += static_cast<double>(j - i);
-        for (auto nd : keys[i]) {
+        for (auto nd : faces[i].key) {
           on_group[static_cast<std::size_t>(nd)] = 1;
           if (outer) on_outer[static_cast<std::size_t>(nd)] = 1;
         }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drape/probe_specs.hpp"
+#include "fem/memory_estimate.hpp"
 #include "fem/model.hpp"
 #include "impact/case/crush_case.hpp"
 
@@ -72,6 +73,9 @@ struct OutputSettings {
   // every checkpoint_every_cycles cycles (0: off; for tests: a checkpoint at a known cycle).
   double checkpoint_interval_min = 10.0;
   std::int64_t checkpoint_every_cycles = 0;
+  /// What of this the memory estimate counts (fem/memory_estimate.hpp): frames, the VTU copies,
+  /// the figures drawn in the run's process, and a checkpoint (a run may always write one).
+  fem::OutputMemory memory() const { return {xdmf || vtu, vtu, figures, true}; }
 };
 
 /// A curve plot from history.csv: y columns against an x column.

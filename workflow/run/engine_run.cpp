@@ -6,7 +6,6 @@
 
 #include <fmt/format.h>
 #include <spdlog/logger.h>
-#include <sys/resource.h>
 #include <time.h>
 
 #include <algorithm>
@@ -213,9 +212,6 @@ double thread_cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// The process's largest resident set so far (what a user sizes a machine by), MB.
-double peak_memory_mb() { return fem::peak_resident_mb(); }
-
 void log_start(const Run& r) {
   r.log->info("ncfsim {} | case '{}' ({}) | resolution {}", kVersion, r.ec.name, r.ec.file.string(),
               r.ec.resolution);
@@ -243,7 +239,7 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
                   const RunHistory& history, const FrameOutput& frames) {
   r.summary["status"] = r.status;
   r.summary["wall_seconds"] = r.wall_seconds();
-  r.summary["peak_memory_MB"] = peak_memory_mb();
+  r.summary["peak_memory_MB"] = fem::peak_resident_mb();
   r.summary["frames"] = frames.written();
   r.summary["frame_write_errors"] = frames.errors();
   add_state_summary(s, r.max_error(), r.summary);
@@ -856,7 +852,7 @@ int finish_run(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHi
   if (!StopRequest::requested()) {
     draw_figures_and_report(r);
     // The figures are drawn in this process: its peak counts them.
-    r.summary["peak_memory_MB"] = peak_memory_mb();
+    r.summary["peak_memory_MB"] = fem::peak_resident_mb();
     r.write_summary();
   }
   if (StopRequest::requested() && r.status == "completed") {
@@ -908,9 +904,8 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
   fem::CheckpointTree checkpoint;
   std::optional<OutputFolder> folder;
   std::int64_t cycle = 0;
-  const fem::MemoryEstimate memory = fem::estimate_memory(
-      ec.model, fem::PetscSession::size(),
-      {ec.output.xdmf || ec.output.vtu, ec.output.vtu, ec.output.figures, true});
+  const fem::MemoryEstimate memory =
+      fem::estimate_memory(ec.model, fem::PetscSession::size(), ec.output.memory());
   try {
     // A model too large for the machine is bad input, refused before anything is written.
     fem::require_memory_fits(memory, ec.file.string());

@@ -35,8 +35,7 @@ int check_engine_stage(const StageCall& call) {
   // Building the solver checks what only the assembled model can show (massless nodes, steps).
   fem::PetscSession petsc;
   if (const int code = refuse_many_ranks()) return code;
-  const fem::MemoryEstimate memory = fem::estimate_memory(
-      ec.model, 1, {ec.output.xdmf || ec.output.vtu, ec.output.vtu, ec.output.figures, true});
+  const fem::MemoryEstimate memory = fem::estimate_memory(ec.model, 1, ec.output.memory());
   fem::ExplicitSolver probe(ec.model);
   std::printf(
       "%s: OK (case '%s', %zu nodes, %s, stable step %.4g s, about %.3g cycles; memory %s of %s "

@@ -43,18 +43,17 @@ fem::io::StageFrame read_source(const transfer::TransferCase& tc) {
 // hexahedron, as a dome is trimmed out of its blank), the result writer's mesh, the figures
 // (measured: 185 MB, as a run's).
 fem::MemoryEstimate transfer_memory(const fem::io::StageFrame& frame, bool figures) {
-  constexpr double kProgram = 64e6, kFigures = 185e6;
   constexpr double kFramePerNode = 32 + 24 + 48, kFramePerCell = 88 + 200;
   constexpr double kModelPerHex = 600, kWriterPerNode = 32, kWriterPerHex = 88;
   const double nodes = static_cast<double>(frame.n_points());
   const double hex = static_cast<double>(frame.mesh.hex8.size() / 8);
   const double cells = hex + static_cast<double>(frame.mesh.bar2.size() / 2);
   fem::MemoryEstimate est;
-  est.shares.push_back({"program", kProgram});
+  est.shares.push_back({"program", fem::kProgramBytes});
   est.shares.push_back({"source frame", kFramePerNode * nodes + kFramePerCell * cells});
   est.shares.push_back({"impregnated model and ties", kModelPerHex * hex});
-  est.shares.push_back(
-      {"output", kWriterPerNode * nodes + kWriterPerHex * hex + (figures ? kFigures : 0.0)});
+  est.shares.push_back({"output", kWriterPerNode * nodes + kWriterPerHex * hex +
+                                      (figures ? fem::kFiguresBytes : 0.0)});
   return est;
 }
 
