@@ -50,38 +50,51 @@ std::vector<std::int32_t> lattice_outline_nodes(const std::vector<std::vector<st
   return out;
 }
 
-}  // namespace
+// What the spec and the blanket make of each other: the sizes the steps below share.
+struct BlanketLayout {
+  double Lx, Ly;                     // blanket size
+  double p, w, t;                    // tow pitch, width, thickness
+  double s, g;                       // penetration spacing along the wales, gauge across them
+  std::array<double, 2> lo, hi;      // the blanket rectangle
+  std::array<double, 2> mdir, ndir;  // along and across the wales
+  int nx, ny;                        // penetrations along and across, centred in the blanket
+  double x_first, y_first;           // the first penetration point
+  double h_el;                       // element length along a tow
+  int nw, nt;                        // elements across a tow and through its thickness
+};
 
-FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl, const std::string& file,
-                             const std::string& prefix, const std::string& key_path) {
-  // The spec as meshed (a case's resolution scales its divisions); the keys are checked here once.
-  validate(f, file, !key_path.empty() ? key_path : prefix.empty() ? "fabric" : prefix);
-  const std::string size_key = key_path.empty() ? prefix + "size" : key_path + ".size";
-  const double Lx = bl.size[0], Ly = bl.size[1];
-  const double p = f.tow_pitch(), w = f.tow_width, t = f.tow_thickness();
-  const double s = f.penetration_spacing(), g = f.gauge();
-  if (!(Lx >= p * (1 - 1e-9) && Ly >= p * (1 - 1e-9)))
-    throw InputError(file, size_key,
-                     "the blanket must be at least one tow pitch (" + std::to_string(p) + " m) long and wide");
-  FabricModel fm;
-  // Per tow node: its next node along the tow, same face (the connections' tow axis).
-  std::vector<std::int32_t> axis_neighbour;
-  fm.tow_thickness = t;
-  const std::array<double, 2> lo{bl.origin[0], bl.origin[1]}, hi{bl.origin[0] + Lx, bl.origin[1] + Ly};
+BlanketLayout layout_of(const FabricSpec& f, const BlanketSpec& bl) {
+  BlanketLayout L{};
+  L.Lx = bl.size[0], L.Ly = bl.size[1];
+  L.p = f.tow_pitch(), L.w = f.tow_width, L.t = f.tow_thickness();
+  L.s = f.penetration_spacing(), L.g = f.gauge();
+  L.lo = {bl.origin[0], bl.origin[1]};
+  L.hi = {bl.origin[0] + L.Lx, bl.origin[1] + L.Ly};
   // Penetration lattice: along the wales m (the stitch direction) every s, across them n every g,
   // centred in the blanket; points closer to the edge than half a spacing are left out. Its
   // reference point sets the gap lines of every ply. With the wales along x this is the centred
   // nx x ny grid.
   const double md = f.stitch_direction_deg * M_PI / 180.0;
-  const std::array<double, 2> mdir{std::cos(md), std::sin(md)}, ndir{-std::sin(md), std::cos(md)};
-  const int nx = static_cast<int>(std::floor(Lx / s)), ny = static_cast<int>(std::floor(Ly / g));
-  const double cx = lo[0] + 0.5 * Lx, cy = lo[1] + 0.5 * Ly;
-  const double x_first = cx - 0.5 * (nx - 1) * s * mdir[0] - 0.5 * (ny - 1) * g * ndir[0];
-  const double y_first = cy - 0.5 * (nx - 1) * s * mdir[1] - 0.5 * (ny - 1) * g * ndir[1];
-  const double h_el = f.element_length > 0 ? f.element_length : p;
-  const int nw = f.elements_across_tow, nt = f.elements_through_thickness;
+  L.mdir = {std::cos(md), std::sin(md)};
+  L.ndir = {-std::sin(md), std::cos(md)};
+  L.nx = static_cast<int>(std::floor(L.Lx / L.s)), L.ny = static_cast<int>(std::floor(L.Ly / L.g));
+  const double cx = L.lo[0] + 0.5 * L.Lx, cy = L.lo[1] + 0.5 * L.Ly;
+  L.x_first = cx - 0.5 * (L.nx - 1) * L.s * L.mdir[0] - 0.5 * (L.ny - 1) * L.g * L.ndir[0];
+  L.y_first = cy - 0.5 * (L.nx - 1) * L.s * L.mdir[1] - 0.5 * (L.ny - 1) * L.g * L.ndir[1];
+  L.h_el = f.element_length > 0 ? f.element_length : L.p;
+  L.nw = f.elements_across_tow, L.nt = f.elements_through_thickness;
+  return L;
+}
 
-  // Tows, ply by ply.
+// The tows, ply by ply: each a structured grid of hexahedra along its strip of the blanket
+// (strips the rectangle cuts too short are dropped and counted); axis_neighbour: per tow node,
+// its next node along the tow on the same face.
+void mesh_tows(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl, const BlanketLayout& L,
+               const std::string& prefix, FabricModel& fm,
+               std::vector<std::int32_t>& axis_neighbour) {
+  const double p = L.p, w = L.w, t = L.t, h_el = L.h_el, x_first = L.x_first, y_first = L.y_first;
+  const std::array<double, 2> lo = L.lo, hi = L.hi;
+  const int nw = L.nw, nt = L.nt;
   for (std::size_t q = 0; q < f.ply_angles_deg.size(); ++q) {
     const int part = mesh.add_part(prefix + "ply" + std::to_string(q + 1));
     fm.ply_parts.push_back(part);
@@ -164,8 +177,17 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       hexes.tow.resize(hexes.size(), tow);
     }
   }
+}
 
-  if (f.stitch == StitchPattern::None) return fm;
+// The stitch: nodes at the penetration points on every ply boundary, the pillars on the top face,
+// the underlaps on the bottom face (tricot: zigzag between neighbouring wales) and a leg per ply.
+void mesh_stitch(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl,
+                 const BlanketLayout& L, const std::string& file, const std::string& size_key,
+                 const std::string& prefix, FabricModel& fm) {
+  const double Lx = L.Lx, Ly = L.Ly, t = L.t, s = L.s, g = L.g, x_first = L.x_first,
+               y_first = L.y_first;
+  const std::array<double, 2> lo = L.lo, hi = L.hi, mdir = L.mdir, ndir = L.ndir;
+  const int nx = L.nx, ny = L.ny;
 
   // Stitch nodes at the penetration points, one on every ply boundary (bottom face, interfaces,
   // top face). Lattice index (i, j), i along the wale; index ranges cover the blanket whatever the
@@ -174,7 +196,6 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   // each other at the stitch points (with a leg from the top to the bottom face only, held at its
   // ends, a relative slide d of the plies there met only the leg's second-order stretch d^2/2l).
   const std::size_t n_levels = f.ply_angles_deg.size() + 1;
-  const double z_bot = bl.z0, z_top = bl.z0 + t * static_cast<double>(f.ply_angles_deg.size());
   auto level_z = [&](std::size_t k) { return bl.z0 + t * static_cast<double>(k); };
   const int reach_i = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / s)) + 1;
   const int reach_j = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / g)) + 1;
@@ -234,12 +255,21 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
     for (int j = 0; j < nj; ++j)
       for (int i = 0; i < ni; ++i)
         bar(at(level[k + 1], i, j), at(level[k], i, j), fm.stitch_leg_part);
+}
 
-  // Connections: each stitch node to the nearest node of every tow within reach on its ply
-  // boundary (on an interface: the tows of both plies). The reach grows with the element length
-  // so that the nearest node of a tow beside the gap is found; on meshes with elements longer
-  // than the tow pitch (the case files' coarse resolution) it also takes the next tows over
-  // (docs/fabric-data.md).
+// Each stitch node joined to the nearest node of every tow within reach on its ply boundary.
+void connect_stitch_to_tows(const fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl,
+                            const BlanketLayout& L, const std::vector<std::int32_t>& axis_neighbour,
+                            FabricModel& fm) {
+  const double w = L.w, t = L.t, h_el = L.h_el;
+  const int nw = L.nw;
+  const std::size_t n_levels = f.ply_angles_deg.size() + 1;
+  const double z_bot = bl.z0, z_top = bl.z0 + t * static_cast<double>(f.ply_angles_deg.size());
+  auto level_z = [&](std::size_t k) { return bl.z0 + t * static_cast<double>(k); };
+  // Each stitch node to the nearest node of every tow within reach on its ply boundary (on an
+  // interface: the tows of both plies). The reach grows with the element length so that the nearest
+  // node of a tow beside the gap is found; on meshes with elements longer than the tow pitch (the
+  // case files' coarse resolution) it also takes the next tows over (docs/fabric-data.md).
   const double reach = 0.5 * f.tow_gap + std::max(w / nw, h_el) * 0.75;
   const double cell = reach;
   const double z_tol = 1e-9 * (1 + std::abs(z_top) + std::abs(z_bot));
@@ -283,6 +313,28 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
       fm.connections.push_back(
           {sn, dn.second, axis_neighbour[static_cast<std::size_t>(dn.second)]});
   }
+}
+
+}  // namespace
+
+FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl,
+                             const std::string& file, const std::string& prefix,
+                             const std::string& key_path) {
+  // The spec as meshed (a case's resolution scales its divisions); the keys are checked here once.
+  validate(f, file, !key_path.empty() ? key_path : prefix.empty() ? "fabric" : prefix);
+  const std::string size_key = key_path.empty() ? prefix + "size" : key_path + ".size";
+  const BlanketLayout L = layout_of(f, bl);
+  if (!(L.Lx >= L.p * (1 - 1e-9) && L.Ly >= L.p * (1 - 1e-9)))
+    throw InputError(
+        file, size_key,
+        "the blanket must be at least one tow pitch (" + std::to_string(L.p) + " m) long and wide");
+  FabricModel fm;
+  fm.tow_thickness = L.t;
+  std::vector<std::int32_t> axis_neighbour;
+  mesh_tows(mesh, f, bl, L, prefix, fm, axis_neighbour);
+  if (f.stitch == StitchPattern::None) return fm;
+  mesh_stitch(mesh, f, bl, L, file, size_key, prefix, fm);
+  connect_stitch_to_tows(mesh, f, bl, L, axis_neighbour, fm);
   return fm;
 }
 

@@ -34,6 +34,9 @@ class RunMeasure {
 
   /// Log lines once the model is set up (what the measure found), in the run's log.
   virtual std::vector<std::string> setup_lines() const { return {}; }
+  /// Warning lines once the model is set up (what the user should know the run changed or
+  /// doubts: the log's warnings, warnings.txt and the workflow report).
+  virtual std::vector<std::string> setup_warnings() const { return {}; }
   /// Appends its history.csv column names (units in the names). `columns` holds those of the
   /// measures before it: a measure may look one up (its value is then in `row` at add_values).
   /// Called once before the loop; bad input throws InputError.

@@ -23,8 +23,9 @@ constexpr double kFullDamage = 1.0 - 1e-9;
 
 }  // namespace
 
-CrushMeasure::CrushMeasure(const fem::ExplicitSolver& s, int punch, double cfc)
-    : punch_(punch), cfc_(cfc) {
+CrushMeasure::CrushMeasure(const fem::ExplicitSolver& s, int punch, double cfc,
+                           CrackBandRaise crack_band)
+    : punch_(punch), cfc_(cfc), crack_band_(std::move(crack_band)) {
   const auto& model = s.model();
   punch_name_ = model.tools.at(static_cast<std::size_t>(punch)).name;
   for (const auto& c : model.contacts)
@@ -143,6 +144,7 @@ void CrushMeasure::add_summary(const fem::ExplicitSolver& s, nlohmann::json& sum
     if (i > 0) work += 0.5 * (force_[i] + force_[i - 1]) * (stroke_[i] - stroke_[i - 1]);
   }
   summary["cfc_class"] = cfc_;
+  summary["crack_band_raised"] = crack_band_.to_json();
   summary["peak_force_N"] = fem::json_number(peak);
   summary["peak_force_filtered"] = why_raw.empty();
   if (!why_raw.empty())

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fem/run_measure.hpp"
+#include "impact/crack_band.hpp"
 
 namespace ncfsim::fem {
 struct Hex8Block;
@@ -18,10 +19,12 @@ namespace ncfsim::impact {
 
 class CrushMeasure final : public fem::RunMeasure {
  public:
-  /// `punch`: index into the model's tools; `cfc`: the filter's channel frequency class.
-  CrushMeasure(const fem::ExplicitSolver& s, int punch, double cfc);
+  /// `punch`: index into the model's tools; `cfc`: the filter's channel frequency class;
+  /// `crack_band`: the fracture energies the case's laws raised (reported).
+  CrushMeasure(const fem::ExplicitSolver& s, int punch, double cfc, CrackBandRaise crack_band = {});
 
   std::vector<std::string> setup_lines() const override;
+  std::vector<std::string> setup_warnings() const override { return crack_band_.warnings(); }
   void add_columns(std::vector<std::string>& columns) override;
   void add_values(const fem::ExplicitSolver& s, std::vector<double>& row) const override;
   bool needs_final_columns() const override { return true; }
@@ -57,6 +60,7 @@ class CrushMeasure final : public fem::RunMeasure {
 
   int punch_;
   double cfc_;
+  CrackBandRaise crack_band_;
   std::string punch_name_;
   std::vector<const fem::TiedContact*> ties_;         // the resin bonds
   std::vector<const fem::TiedContact*> stitch_ties_;  // the cured stitch's nodes on the tows

@@ -41,6 +41,12 @@ TowDamageMaterial::TowDamageMaterial(std::string name, const TowDamageConstants&
     const auto k = static_cast<std::size_t>(m);
     rf_length_[k] = 2 * c.fracture_energy[k] * modulus_[k] / (strength_[k] * strength_[k]);
   }
+  if (c.raise_to_crack_band) rf_floor_ = kRaisedFailureRatio;
+}
+
+double TowDamageMaterial::raised_energy_factor(FailureMode m, double L) const {
+  if (!c_.raise_to_crack_band) return 1.0;
+  return std::max(1.0, rf_floor_ * L / rf_length_[static_cast<std::size_t>(m)]);
 }
 
 double TowDamageMaterial::max_element_length(FailureMode m) const {
@@ -78,7 +84,7 @@ void TowDamageMaterial::update_stress(const fem::MaterialBatch& b) const {
     for (int m = 0; m < kModes; ++m) {
       double& r = h[(6 + m) * s + e];
       r = std::max({r, f[m], 1.0});
-      const double rf = std::max(rf_length_[static_cast<std::size_t>(m)] / L[m], 1.0 + 1e-9);
+      const double rf = std::max(rf_length_[static_cast<std::size_t>(m)] / L[m], rf_floor_);
       const double dm = std::min(1.0, (1.0 - 1.0 / r) / (1.0 - 1.0 / rf));
       // damage never heals (the length of a crushed element may change its r_f)
       d[m] = h[(12 + m) * s + e] = std::max(h[(12 + m) * s + e], dm);

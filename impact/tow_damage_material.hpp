@@ -15,7 +15,9 @@
 //   fracture energy per area, L_m the element's length across the crack, E_m the modulus of the
 //   mode), d_m = (1 - 1/r_m) / (1 - 1/r_f), so that a uniaxial (or pure-shear) path peaks at the
 //   strength and dissipates G_m / L_m per volume whatever the mesh. r_f must exceed 1: the element
-//   must be short enough not to snap back, L_m < 2 G_m E_m / X_m^2 (checked).
+//   must be short enough not to snap back, L_m < 2 G_m E_m / X_m^2 (checked: the case refuses a
+//   longer one, or with `raise_to_crack_band` gives it the smallest energy free of snap-back,
+//   r_f = kRaisedFailureRatio, G = kRaisedFailureRatio X_m^2 L_m / (2 E_m), reported).
 //   degradation: s11 (1 - d_ft or d_fc by its sign), s22 and s33 (1 - d_mt or d_mc by their signs),
 //   a compressive one held at least at min(|C E|, residual_compression x Xc or Yc) (crush plateau),
 //   s12 and s13 (1 - d_s12)(1 - d_mt)(1 - d_ft): a cracked matrix and broken fibres carry no axial
@@ -40,6 +42,9 @@ enum class FailureMode {
   TransverseShear
 };
 constexpr int kModes = 6;
+/// r_f of an element longer than its crack band when the law raises its energy (the failure
+/// strain 0.1 % past the initiation strain: the steepest softening that does not snap back).
+constexpr double kRaisedFailureRatio = 1.001;
 /// Result-field names, in FailureMode order (damage_<name>, failed_fraction_<name>).
 constexpr std::array<const char*, kModes> kModeNames{"fibre_tension",  "fibre_compression",
                                                      "matrix_tension", "matrix_compression",
@@ -67,6 +72,10 @@ struct TowDamageConstants {
   /// crushed composite keeps bearing (the crush plateau); with 0 a tow failed in compression
   /// carries nothing and collapses under a punch. Elastic on the way back (no energy created).
   double residual_compression = 0;
+  /// An element longer across a crack than 2 G E / X^2: false, the case refuses it
+  /// (check_crack_band); true (`crack_band = "raise"`), its energy in that mode is raised to
+  /// kRaisedFailureRatio X^2 L / (2 E), from its current length, element by element.
+  bool raise_to_crack_band = false;
 };
 
 class TowDamageMaterial final : public fem::SolidMaterial {
@@ -85,6 +94,9 @@ class TowDamageMaterial final : public fem::SolidMaterial {
 
   /// The longest element (m) across a crack of mode m that does not snap back: 2 G E / X^2.
   double max_element_length(FailureMode m) const;
+  /// The factor on the fracture energy of mode m the law applies to an element L long across
+  /// its crack: 1 where L is within the crack band, above it when the law raises (else 1).
+  double raised_energy_factor(FailureMode m, double L) const;
   const TowDamageConstants& constants() const { return c_; }
 
  private:
@@ -92,6 +104,7 @@ class TowDamageMaterial final : public fem::SolidMaterial {
   TowDamageConstants c_;
   fem::Voigt6x6 C_{};
   std::array<double, kModes> strength_{}, modulus_{}, rf_length_{};
+  double rf_floor_ = 1.0 + 1e-9;  // the smallest r_f (kRaisedFailureRatio when raising)
   std::array<double, kModes>
       erode_{};  // 1: the mode's full damage fails the element  // per mode; rf = rf_length / L
 };

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "fem/case/stage_kinds.hpp"
 #include "fem/errors.hpp"
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
@@ -241,7 +242,8 @@ int run_export(const std::string& folder, const std::string& deck_format) {
 int run_status(const std::string& folder) {
   require_output_folder(folder);
   for (const auto& f : wf::folder_status(folder))
-    std::printf("%s: %s%s\n", f.dir.c_str(), f.stage == "engine" ? "" : (f.stage + " ").c_str(),
+    std::printf("%s: %s%s\n", f.dir.c_str(),
+                f.stage == ncfsim::fem::stage_kind::kEngine ? "" : (f.stage + " ").c_str(),
                 f.line.c_str());
   return wf::kSuccess;
 }

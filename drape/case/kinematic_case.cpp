@@ -4,6 +4,7 @@
 
 #include "drape/case/drape_case.hpp"
 #include "fem/case/fem_case.hpp"
+#include "fem/case/stage_kinds.hpp"
 #include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
 
@@ -51,7 +52,7 @@ KinematicDrapeCase load_kinematic_drape_case(const std::filesystem::path& file,
   KinematicDrapeCase kc;
   kc.file = file;
   kc.overrides = overrides;
-  const auto header = fem::read_stage_case_header(root, "kinematic_drape");
+  const auto header = fem::read_stage_case_header(root, fem::stage_kind::kKinematicDrape);
   kc.name = header.name;
   kc.description = header.description;
   const auto surfaces = root.tables("surface");

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "fem/case/stage_kinds.hpp"
+
 namespace ncfsim::fem {
 
 ResultRecord result_record(const std::filesystem::path& result_file) {
@@ -14,7 +16,8 @@ ResultRecord result_record(const std::filesystem::path& result_file) {
   const auto j = nlohmann::json::parse(in, nullptr, false);
   r.found = true;
   if (!j.is_object()) return r;                       // stage and status stay empty: refused below
-  r.stage = j.value("stage", std::string("engine"));  // summaries before the key: engine runs
+  r.stage = j.value(
+      "stage", std::string(fem::stage_kind::kEngine));  // summaries before the key: engine runs
   r.status = j.value("status", std::string());
   return r;
 }

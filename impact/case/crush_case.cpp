@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "fem/case/source_result.hpp"
+#include "fem/case/stage_kinds.hpp"
 #include "fem/contact/tied_contact.hpp"
 #include "fem/elements/hex8_block.hpp"
 #include "fem/errors.hpp"
@@ -31,6 +32,7 @@ void read_damage_keys(const TableReader& t, TowDamageConstants& c) {
         fe.number(kModeNames[static_cast<std::size_t>(m)], Range::positive());
   c.fracture_energy_key = t.key_path("fracture_energy");
   c.residual_compression = t.number("residual_compression", 0.0, Range{0, 1, false, true});
+  c.raise_to_crack_band = t.choice("crack_band", {"refuse", "raise"}, "refuse") == "raise";
   if (t.has("erode_on")) {
     c.erode_on.fill(false);
     for (const auto& name : t.strings("erode_on")) {
@@ -136,7 +138,7 @@ fem::io::StageFrame read_source_frame(const TableReader& m, ImpregnatedImport& i
   if (!std::filesystem::exists(im.source))
     m.fail("source", "no such file: " + im.source.string() +
                          " (run the transfer first: ncfsim run cases/hemisphere/transfer.toml)");
-  fem::require_result_of(m, "source", im.source, {"transfer"},
+  fem::require_result_of(m, "source", im.source, {fem::stage_kind::kTransfer},
                          "a crush needs a transfer's results (ncfsim run "
                          "cases/hemisphere/transfer.toml makes one)");
   fem::io::StageFrame fr;
@@ -418,7 +420,7 @@ void assign_impregnated_parts(CaseReadContext& ctx, const ImpregnatedImport& im)
         ties->fail(key, "the transfer bonded no interface '" + key + "' (ties.csv)");
 }
 
-void check_crack_band(const CaseReadContext& ctx) {
+CrackBandRaise check_crack_band(const CaseReadContext& ctx) {
   const fem::Mesh& mesh = ctx.model.mesh;
   const fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
   // Per material: the worst ratio of element length to the crack-band limit, per mode.
@@ -427,6 +429,7 @@ void check_crack_band(const CaseReadContext& ctx) {
     std::int64_t element = 0;
   };
   std::map<const TowDamageMaterial*, std::array<Worst, kModes>> worst;
+  CrackBandRaise raised;
   for (std::size_t h = 0; h < hexes.size(); ++h) {
     const int mi = !hexes.material.empty() && hexes.material[h] >= 0
                        ? hexes.material[h]
@@ -449,6 +452,15 @@ void check_crack_band(const CaseReadContext& ctx) {
     // The length across each mode's crack, as the law takes it (the larger where it chooses).
     const double across[kModes] = {L[0], L[0], std::max(L[1], L[2]), std::max(L[1], L[2]),
                                    L[1], L[1]};
+    ++raised.elements_checked;
+    if (mat->constants().raise_to_crack_band) {
+      for (int md = 0; md < kModes; ++md) {
+        const double f = mat->raised_energy_factor(static_cast<FailureMode>(md), across[md]);
+        if (!(f > 1.0)) continue;
+        raised.add(md, f, hexes.user_id[h]);
+      }
+      continue;
+    }
     auto& w = worst[mat];
     for (int md = 0; md < kModes; ++md) {
       const double r = across[md] / mat->max_element_length(static_cast<FailureMode>(md));
@@ -469,11 +481,14 @@ void check_crack_band(const CaseReadContext& ctx) {
           ctx.file, key,
           fmt::format("{} J/m^2 is too small for the mesh (snap-back): element {} of material '{}' "
                       "is {:.4g} mm long across a {} crack, above the crack-band limit 2 G E / "
-                      "X^2 = {:.4g} mm; give at least {:.4g} J/m^2 or refine the mesh",
+                      "X^2 = {:.4g} mm; give at least {:.4g} J/m^2, refine the mesh, or let the "
+                      "law raise the energy of the elements too long for it (crack_band = "
+                      "\"raise\" beside the fracture energies)",
                       G, w[k].element, mat->name(), 1e3 * w[k].length, kModeNames[k],
                       1e3 * mat->max_element_length(static_cast<FailureMode>(md)),
                       G * w[k].ratio * 1.001));
     }
+  return raised;
 }
 
 namespace {
@@ -535,7 +550,7 @@ void check_crush_process(const CaseReadContext& ctx, const TableReader& crush,
 
 CrushSpec read_crush(const CaseReadContext& ctx) {
   CrushSpec cs;
-  const auto t = ctx.root.table("crush");
+  const auto t = ctx.root.table("crush");  // the [crush] table: not a stage kind
   if (!t) return cs;
   cs.enabled = true;
   const std::string punch = t->string("punch");

@@ -15,6 +15,7 @@
 #include "fem/case/case_context.hpp"
 #include "fem/contact/contact_config.hpp"
 #include "fem/material.hpp"
+#include "impact/crack_band.hpp"
 #include "impact/tow_damage_material.hpp"
 
 namespace ncfsim::impact {
@@ -59,16 +60,18 @@ ImpregnatedImport read_impregnated_model(fem::CaseReadContext& ctx);
 /// and the tied interfaces ([model.ties.*]) as cohesive tied contacts.
 void assign_impregnated_parts(fem::CaseReadContext& ctx, const ImpregnatedImport& import);
 
-/// Throws InputError when a tow_damage element is longer across a crack of some mode than the
-/// crack band allows (2 G E / X^2, snap-back), naming the material's fracture-energy key, the
-/// element, its length, the limit and the smallest fracture energy that would do.
-void check_crack_band(const fem::CaseReadContext& ctx);
+/// The crack band of every tow_damage element (2 G E / X^2, snap-back): an element longer across
+/// a crack of some mode is bad input (InputError naming the material's fracture-energy key, the
+/// element, its length, the limit and the smallest fracture energy that would do), unless its
+/// law raises the energy (crack_band = "raise"): then it is counted in what is returned.
+CrackBandRaise check_crack_band(const fem::CaseReadContext& ctx);
 
 /// [crush]: the punch (a tool of the case) and the CFC class of the filtered force.
 struct CrushSpec {
   bool enabled = false;
   int punch = -1;    // index into Model::tools
   double cfc = 600;  // SAE J211 channel frequency class of the filtered punch force
+  CrackBandRaise crack_band;  // what check_crack_band found (a crush's log, summary and report)
 };
 CrushSpec read_crush(const fem::CaseReadContext& ctx);
 

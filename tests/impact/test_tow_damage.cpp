@@ -181,6 +181,32 @@ TEST(TowDamage, AxialShearBringsFibreKinkingOn) {
   }
 }
 
+// An element longer than its crack band (issue #42): with crack_band = "raise" its energy is the
+// smallest free of snap-back, r_f = 1.001 (failure 0.1 % of the initiation strain past it): the
+// stress still peaks at the strength, falls to zero, and the work per volume is that raised
+// energy over the length, 1.001 X^2 / (2 E); the factor the law reports is that energy over the
+// given one, 1.001 L / (2 G E / X^2). Within the band the law leaves the energy as given.
+TEST(TowDamage, ElementsLongerThanTheirCrackBandGetTheSmallestEnergyFreeOfSnapBack) {
+  auto c = t700_epoxy();
+  c.raise_to_crack_band = true;
+  const impact::TowDamageMaterial mat("tow", c);
+  const double X = 2.97e9, E1 = 139e9, band = mat.max_element_length(FailureMode::FibreTension);
+  const double L = 3 * band;
+  const double factor = mat.raised_energy_factor(FailureMode::FibreTension, L);
+  EXPECT_TRUE(test::near_rel(factor, 1.001 * 3, 1e-12)) << factor;
+  EXPECT_EQ(mat.raised_energy_factor(FailureMode::FibreTension, 0.5 * band), 1.0);
+  const double strain_peak = X / E1;
+  const auto curve = drive(mat, L, 0, 1, 1.2 * strain_peak, 24000);
+  EXPECT_TRUE(test::near_rel(curve.peak, X, 0.001));
+  const double G_raised = factor * c.fracture_energy[0];
+  EXPECT_TRUE(test::near_rel(curve.energy, G_raised / L, 0.001)) << curve.energy;
+  EXPECT_TRUE(test::near_rel(G_raised / L, 1.001 * X * X / (2 * E1), 1e-9));
+  EXPECT_NEAR(curve.final_stress, 0.0, 1e-9 * X);
+  // Refusing (the default), the law reports no factor: the case refuses such an element.
+  const impact::TowDamageMaterial refusing("tow", t700_epoxy());
+  EXPECT_EQ(refusing.raised_energy_factor(FailureMode::FibreTension, L), 1.0);
+}
+
 TEST(TowDamage, SnapBackLengthAndBadConstantsAreReported) {
   auto c = t700_epoxy();
   const impact::TowDamageMaterial mat("tow", c);

@@ -5,6 +5,7 @@
 
 #include "fem/case/fem_case.hpp"
 #include "fem/case/source_result.hpp"
+#include "fem/case/stage_kinds.hpp"
 #include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
 
@@ -37,7 +38,7 @@ void read_resin(const TableReader& t, ResinData& r) {
 void check_source(const TableReader& s, const std::filesystem::path& h5) {
   if (!std::filesystem::is_regular_file(h5))
     s.fail("results", "no such drape result: " + h5.string() + " (run the drape case first)");
-  fem::require_result_of(s, "results", h5, {"engine"},
+  fem::require_result_of(s, "results", h5, {fem::stage_kind::kEngine},
                          "a transfer needs the results.h5 of a meso drape run");
 }
 
@@ -50,7 +51,7 @@ TransferCase load_transfer_case(const std::filesystem::path& file,
   TransferCase tc;
   tc.file = file;
   tc.overrides = overrides;
-  const auto header = fem::read_stage_case_header(root, "transfer");
+  const auto header = fem::read_stage_case_header(root, fem::stage_kind::kTransfer);
   tc.name = header.name;
   tc.description = header.description;
 

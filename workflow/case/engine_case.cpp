@@ -8,6 +8,7 @@
 #include "drape/case/drape_case.hpp"
 #include "fem/case/case_context.hpp"
 #include "fem/case/fem_case.hpp"
+#include "fem/case/stage_kinds.hpp"
 #include "fem/errors.hpp"
 
 namespace ncfsim::workflow {
@@ -20,7 +21,8 @@ using fem::TableReader;
 void read_case_header(const TableReader& root, EngineCase& ec) {
   const TableReader c = root.required_table("case");
   ec.name = fem::read_case_name(c);
-  ec.kind = c.choice("kind", {"engine", "crush"}, "engine");
+  ec.kind = c.choice("kind", {fem::stage_kind::kEngine, fem::stage_kind::kCrush},
+                     fem::stage_kind::kEngine);
   ec.description = c.string("description", "");
 }
 
@@ -210,7 +212,7 @@ EngineCase load_engine_case(const std::filesystem::path& file,
   const bool imported = impact::has_impregnated_model(ctx);
   if (imported && ctx.root.has("mesh"))
     ctx.root.fail("model", "give either [mesh] or [model] (an imported transfer result), not both");
-  if (ec.kind == "crush" && !imported)
+  if (ec.kind == fem::stage_kind::kCrush && !imported)
     ctx.root.fail(
         "model",
         "missing: a crush case reads its part from a transfer's results ([model] source = ...)");
@@ -239,7 +241,7 @@ EngineCase load_engine_case(const std::filesystem::path& file,
   ec.crush = impact::read_crush(ctx);
   read_output(ctx, ec);
   read_figures(ctx, ec);
-  impact::check_crack_band(ctx);
+  ec.crush.crack_band = impact::check_crack_band(ctx);
   doc.check_unknown_keys();
   return ec;
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 
+#include "fem/case/stage_kinds.hpp"
 #include "fem/errors.hpp"
 #include "fem/run_measure.hpp"
 #include "workflow/render/render.hpp"
@@ -125,7 +126,7 @@ std::vector<RingSource> read_run_folder(const fs::path& dir, const std::string& 
   std::vector<RingSource> out;
   if (!fs::exists(csv)) {
     // A workflow folder: the ring of each of its stages that measured one.
-    if (summary.is_object() && summary.value("stage", "") == "workflow" &&
+    if (summary.is_object() && summary.value("stage", "") == fem::stage_kind::kWorkflow &&
         summary.contains("stages") && summary["stages"].is_array()) {
       for (const auto& st : summary["stages"]) {
         if (!st.is_object() || !st.contains("folder") || !st["folder"].is_string()) continue;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <thread>
 
+#include "fem/case/stage_kinds.hpp"
 #include "fem/errors.hpp"
 #include "workflow/output/folder_lock.hpp"
 #include "workflow/output/output_files.hpp"
@@ -51,7 +52,7 @@ FolderStatus status_of(const fs::path& dir) {
     throw InputError((dir / "summary.json").string(), "",
                      "missing or unreadable: not the output folder of a run (or a run that "
                      "ended before it wrote anything)");
-  f.stage = s.value("stage", "engine");
+  f.stage = s.value("stage", fem::stage_kind::kEngine);
   f.status = s.value("status", "?");
   std::string where;
   if (s.contains("cycles")) where += ", cycle " + s["cycles"].dump();
@@ -94,7 +95,7 @@ FolderStatus status_of(const fs::path& dir) {
 
 std::vector<FolderStatus> folder_status(const fs::path& dir) {
   std::vector<FolderStatus> all{status_of(dir)};
-  if (all.front().stage != "workflow") return all;
+  if (all.front().stage != fem::stage_kind::kWorkflow) return all;
   // The stage folders (a workflow killed early has not listed them in its summary yet).
   std::vector<fs::path> stages;
   std::error_code ec;

@@ -940,8 +940,10 @@ int run_engine_case(EngineCase& ec, const RunOptions& options) {
               memory.describe());
   r.summary["memory_estimate_MB"] = memory.per_rank() / 1e6;
   MeasureList measures = make_run_measures(ec, solver);
-  for (const auto& m : measures)
+  for (const auto& m : measures) {
     for (const auto& line : m->setup_lines()) r.log->info("{}", line);
+    for (const auto& line : m->setup_warnings()) r.log->warn("{}", line);
+  }
   RunHistory history(r.dir / "history.csv", measures, !ec.samples.empty() || !ec.means.empty());
   FrameOutput frames(r.dir, ec.output, solver, options.resume);
   if (options.resume) {

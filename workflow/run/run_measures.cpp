@@ -215,7 +215,8 @@ MeasureList make_run_measures(const EngineCase& ec, const fem::ExplicitSolver& s
       m.push_back(std::make_unique<drape::RingShearMeasure>(rp, s));
   if (auto curve = make_bias_extension_curve(ec)) m.push_back(std::move(curve));
   if (ec.crush.enabled)
-    m.push_back(std::make_unique<impact::CrushMeasure>(s, ec.crush.punch, ec.crush.cfc));
+    m.push_back(std::make_unique<impact::CrushMeasure>(s, ec.crush.punch, ec.crush.cfc,
+                                                       ec.crush.crack_band));
   m.push_back(std::make_unique<ContactResultants>());
   if (!ec.fabric_summaries.empty())
     m.push_back(std::make_unique<drape::FabricReport>(ec.fabric_summaries, model));

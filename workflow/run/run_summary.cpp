@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fem/case/stage_kinds.hpp"
 #include "workflow/run/engine_run.hpp"
 #include "workflow/run/run_measures.hpp"
 #include "workflow/version.hpp"
@@ -22,7 +23,7 @@ std::string element_counts(const fem::ExplicitSolver& s) {
 json summary_header(const EngineCase& ec, const RunOptions& options) {
   json summary;
   summary["case"] = ec.name;
-  summary["stage"] = ec.kind.empty() ? "engine" : ec.kind;  // engine or crush
+  summary["stage"] = ec.kind.empty() ? fem::stage_kind::kEngine : ec.kind;  // engine or crush
   summary["ncfsim_version"] = kVersion;
   summary["case_file"] = ec.file.string();
   summary["overrides"] = options.overrides;

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/case/kinematic_case.hpp"
+#include "fem/case/stage_kinds.hpp"
 #include "workflow/output/output_files.hpp"
 #include "workflow/version.hpp"
 
@@ -64,7 +65,7 @@ int run_kinematic_drape_stage(const StageCall& call) {
 
   write_file_atomically(dir / "ring_shear.csv", drape::ring_csv(ring, "kinematic_shear_deg"));
   write_file_atomically(dir / "net.csv", net_csv(net));
-  nlohmann::json s = stage_summary_header(kc.name, call, "kinematic_drape");
+  nlohmann::json s = stage_summary_header(kc.name, call, fem::stage_kind::kKinematicDrape);
   s["net_joints"] = joints;
   s["net_joints_not_placed"] = net.n_locked;
   s["net_spacing_m"] = net.spacing;

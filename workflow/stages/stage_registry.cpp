@@ -6,6 +6,7 @@
 
 #include "drape/case/kinematic_case.hpp"
 #include "fem/case/model_size.hpp"
+#include "fem/case/stage_kinds.hpp"
 #include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
 #include "fem/memory_estimate.hpp"
@@ -101,7 +102,7 @@ int refuse_many_ranks() {
 
 const std::vector<Stage>& stages() {
   static const std::vector<Stage> registry{
-      {"engine",
+      {fem::stage_kind::kEngine,
        "explicit finite-element run (virtual tests, forming, crush)",
        &run_engine_stage,
        &check_engine_stage,
@@ -110,7 +111,7 @@ const std::vector<Stage>& stages() {
        {{"formed_shear_iso.png", "the formed part by shear angle"}},
        "",
        ""},
-      {"crush",
+      {fem::stage_kind::kCrush,
        "explicit crush of an impregnated part from a transfer (tow damage per mode, cohesive "
        "resin bonds, punch force filtered at a CFC class)",
        &run_engine_stage,
@@ -121,7 +122,7 @@ const std::vector<Stage>& stages() {
         {"failed_mode.png", "failed mode per tow element"}},
        "",
        ""},
-      {"kinematic_drape",
+      {fem::stage_kind::kKinematicDrape,
        "pin-jointed net (fishnet) drape on rigid tool surfaces, ring shear measure",
        &run_kinematic_drape_stage,
        &check_kinematic_drape_stage,
@@ -130,7 +131,7 @@ const std::vector<Stage>& stages() {
        {},
        "kinematic_shear_deg",
        " (pin-jointed net)"},
-      {"transfer",
+      {fem::stage_kind::kTransfer,
        "draped tows to the impregnated composite model (micromechanics, Vf from compaction, ties)",
        &run_transfer_stage,
        &check_transfer_stage,
@@ -139,7 +140,7 @@ const std::vector<Stage>& stages() {
        {},
        "",
        ""},
-      {"workflow",
+      {fem::stage_kind::kWorkflow,
        "stages (drape, fishnet, transfer, crush, ...) from case files of their own into one "
        "folder, unchanged stages skipped, one report",
        &run_workflow_stage,
@@ -172,7 +173,7 @@ std::string case_kind(const std::filesystem::path& file,
                       const std::vector<std::string>& overrides) {
   const fem::CaseDocument doc = fem::CaseDocument::load(file, overrides);
   const auto* c = doc.root()["case"].as_table();
-  if (!c || !c->contains("kind")) return "engine";
+  if (!c || !c->contains("kind")) return fem::stage_kind::kEngine;
   const auto kind = (*c)["kind"].value<std::string>();
   if (!kind)
     throw InputError(file.string(), "case.kind",

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "fem/case/stage_kinds.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/stage_handoff.hpp"
 #include "transfer/deck_export.hpp"
@@ -20,7 +21,7 @@ void require_transfer_run(const std::filesystem::path& dir) {
     throw InputError(dir.string(), "", "no summary.json: not the output folder of a run");
   const nlohmann::json j = read_json_file(summary);
   if (!j.is_object()) throw InputError(dir.string(), "", "summary.json cannot be read");
-  if (j.value("stage", std::string()) != "transfer" ||
+  if (j.value("stage", std::string()) != fem::stage_kind::kTransfer ||
       j.value("status", std::string()) != "completed")
     throw InputError(dir.string(), "",
                      "not a completed transfer run (stage '" + j.value("stage", std::string("?")) +

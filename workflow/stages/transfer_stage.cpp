@@ -9,6 +9,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "fem/case/stage_kinds.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/result_writers.hpp"
 #include "fem/io/stage_handoff.hpp"
@@ -269,7 +270,8 @@ int run_transfer_stage(const StageCall& call) {
   const ImpregnatedModel m = build(tc, frame);
 
   const std::filesystem::path dir = output_folder(tc.name, call.options);
-  const OutputFolder folder = OutputFolder::claim(dir, call.options.overwrite, {}, "transfer");
+  const OutputFolder folder =
+      OutputFolder::claim(dir, call.options.overwrite, {}, fem::stage_kind::kTransfer);
   auto log = make_run_logger(dir, call.options.verbosity);
   log->info("ncfsim {} | case '{}' ({}) | transfer", kVersion, tc.name, call.case_file.string());
   if (!tc.description.empty()) log->info("  {}", tc.description);
@@ -311,7 +313,7 @@ int run_transfer_stage(const StageCall& call) {
   write_file_atomically(dir / "ties.csv", ties_csv(m));
   write_file_atomically(dir / "vf_histogram.csv", vf_histogram_csv(m, tc.spec.mapping));
 
-  nlohmann::json s = stage_summary_header(tc.name, call, "transfer");
+  nlohmann::json s = stage_summary_header(tc.name, call, fem::stage_kind::kTransfer);
   s["source_results"] = tc.results.string();
   s["source_frame"] = frame.index;
   s["source_time_s"] = frame.time;

@@ -15,6 +15,7 @@
 #include <set>
 #include <sstream>
 
+#include "fem/case/stage_kinds.hpp"
 #include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/hdf5_checkpoint.hpp"
@@ -256,7 +257,7 @@ int run_workflow_stage(const StageCall& call) {
   std::vector<std::string> stage_dirs;
   for (const auto& p : plans) stage_dirs.push_back(p.spec.name);
   const OutputFolder folder =
-      OutputFolder::claim(out, call.options.overwrite, stage_dirs, "workflow");
+      OutputFolder::claim(out, call.options.overwrite, stage_dirs, fem::stage_kind::kWorkflow);
   auto log = make_run_logger(out, call.options.verbosity);
   if (!folder.note().empty()) log->warn("{}", folder.note());
   const auto t0 = std::chrono::steady_clock::now();
@@ -266,7 +267,7 @@ int run_workflow_stage(const StageCall& call) {
   log->info("workflow '{}' ({}): {} stages into {}", wc.name, call.case_file.string(), plans.size(),
             out.string());
 
-  json summary = stage_summary_header(wc.name, call, "workflow");
+  json summary = stage_summary_header(wc.name, call, fem::stage_kind::kWorkflow);
   summary["status"] = "running";
   summary["stages"] = json::array();
   const std::size_t n = plans.size();
@@ -672,7 +673,7 @@ void write_workflow_report(const fs::path& dir) {
   const json s = read_json_file(dir / "summary.json");
   if (!s.is_object() || !s.contains("stages"))
     throw std::runtime_error((dir / "summary.json").string() + " is not a workflow's summary");
-  const std::string name = s.value("case", "workflow");
+  const std::string name = s.value("case", fem::stage_kind::kWorkflow);
   std::ostringstream h;
   h << html_head(name + " - ncfsim workflow");
   const std::string status = s.value("status", "unknown");
