@@ -44,6 +44,9 @@ int check_engine_stage(const StageCall& call) {
       call.case_file.c_str(), ec.name.c_str(), ec.model.mesh.n_nodes(),
       element_counts(probe).c_str(), probe.time_step(), ec.model.time.end_time / probe.time_step(),
       memory.describe().c_str(), fem::bytes_text(fem::available_memory_bytes()).c_str());
+  // What the case's laws will change (a crush's crack band raising energies), as the run warns.
+  for (const auto& line : ec.crush.crack_band.warnings())
+    std::printf("warning: %s\n", line.c_str());
   return kSuccess;
 }
 
