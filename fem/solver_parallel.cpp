@@ -11,6 +11,7 @@
 
 #include "fem/boundary/picture_frame_motion.hpp"
 #include "fem/checkpoint.hpp"
+#include "fem/contact/tied_contact.hpp"
 #include "fem/errors.hpp"
 #include "fem/parallel/domain.hpp"
 #include "fem/solver.hpp"
@@ -114,6 +115,15 @@ void ExplicitSolver::gather_for_output() {
     for (std::size_t k = 0; k < nf; ++k)
       frame_wall_contacts_.push_back(static_cast<std::int64_t>(buf[nf + k]));
   }
+  // Tied contacts: the ties other ranks hold failed or intact, into the root's copy (each rank
+  // updates only its own).
+  for (const auto& c : model_.contacts)
+    if (auto* tied = dynamic_cast<TiedContact*>(c.get())) {
+      std::vector<std::uint8_t> states = tied->tie_states();
+      MPI_Reduce(domain_->root() ? MPI_IN_PLACE : states.data(), states.data(),
+                 static_cast<int>(states.size()), MPI_UINT8_T, MPI_MIN, 0, domain_->comm());
+      if (domain_->root()) tied->take_other_ranks_tie_states(states);
+    }
   contact_resultants_.resize(model_.contacts.size());
   contact_max_penetration_.resize(model_.contacts.size());
   for (std::size_t k = 0; k < model_.contacts.size(); ++k) {

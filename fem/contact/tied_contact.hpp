@@ -49,6 +49,15 @@ class TiedContact final : public ContactAlgorithm {
   /// Damage of each tie (0: intact, 1: separated; abrupt ties jump from 0 to 1).
   double damage(std::size_t t) const { return alive_[t] ? state_[t].damage : 1.0; }
   double search_distance() const { return search_distance_; }
+  /// Several ranks: each rank updates only the ties of its own slave nodes. For output the
+  /// solver takes every tie's state at its minimum over the ranks (0 failed, 1 holds, 2 holds
+  /// until the next cycle) and gives it to the root, which keeps its own ties' states and takes
+  /// the others' (so failed_area() counts the whole interface's failures).
+  const std::vector<std::uint8_t>& tie_states() const { return alive_; }
+  void take_other_ranks_tie_states(const std::vector<std::uint8_t>& merged) {
+    for (std::size_t t = 0; t < alive_.size() && t < merged.size(); ++t)
+      if (!mine_.empty() && !mine_[t]) alive_[t] = merged[t];
+  }
   /// Slave nodes beside no master segment (within the search distance): not tied.
   std::size_t untied_nodes() const { return untied_; }
 
