@@ -61,6 +61,10 @@ struct BlanketLayout {
   double x_first, y_first;           // the first penetration point
   double h_el;                       // element length along a tow
   int nw, nt;                        // elements across a tow and through its thickness
+  double z0;                         // the blanket's bottom face
+  std::size_t n_levels;              // ply boundaries: bottom face, interfaces, top face
+  /// Height of ply boundary k (0: the bottom face).
+  double level_z(std::size_t k) const { return z0 + t * static_cast<double>(k); }
 };
 
 BlanketLayout layout_of(const FabricSpec& f, const BlanketSpec& bl) {
@@ -83,6 +87,8 @@ BlanketLayout layout_of(const FabricSpec& f, const BlanketSpec& bl) {
   L.y_first = cy - 0.5 * (L.nx - 1) * L.s * L.mdir[1] - 0.5 * (L.ny - 1) * L.g * L.ndir[1];
   L.h_el = f.element_length > 0 ? f.element_length : L.p;
   L.nw = f.elements_across_tow, L.nt = f.elements_through_thickness;
+  L.z0 = bl.z0;
+  L.n_levels = f.ply_angles_deg.size() + 1;
   return L;
 }
 
@@ -181,11 +187,10 @@ void mesh_tows(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl, cons
 
 // The stitch: nodes at the penetration points on every ply boundary, the pillars on the top face,
 // the underlaps on the bottom face (tricot: zigzag between neighbouring wales) and a leg per ply.
-void mesh_stitch(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl,
-                 const BlanketLayout& L, const std::string& file, const std::string& size_key,
-                 const std::string& prefix, FabricModel& fm) {
-  const double Lx = L.Lx, Ly = L.Ly, t = L.t, s = L.s, g = L.g, x_first = L.x_first,
-               y_first = L.y_first;
+void mesh_stitch(fem::Mesh& mesh, const FabricSpec& f, const BlanketLayout& L,
+                 const std::string& file, const std::string& size_key, const std::string& prefix,
+                 FabricModel& fm) {
+  const double Lx = L.Lx, Ly = L.Ly, s = L.s, g = L.g, x_first = L.x_first, y_first = L.y_first;
   const std::array<double, 2> lo = L.lo, hi = L.hi, mdir = L.mdir, ndir = L.ndir;
   const int nx = L.nx, ny = L.ny;
 
@@ -195,8 +200,7 @@ void mesh_stitch(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl,
   // passes: its nodes at the interfaces join the tows on both sides, so the plies are pinned to
   // each other at the stitch points (with a leg from the top to the bottom face only, held at its
   // ends, a relative slide d of the plies there met only the leg's second-order stretch d^2/2l).
-  const std::size_t n_levels = f.ply_angles_deg.size() + 1;
-  auto level_z = [&](std::size_t k) { return bl.z0 + t * static_cast<double>(k); };
+  const std::size_t n_levels = L.n_levels;
   const int reach_i = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / s)) + 1;
   const int reach_j = static_cast<int>(std::ceil(std::hypot(Lx, Ly) / g)) + 1;
   const int i0 = -reach_i, j0 = -reach_j, ni = 2 * reach_i + nx, nj = 2 * reach_j + ny;
@@ -220,7 +224,7 @@ void mesh_stitch(fem::Mesh& mesh, const FabricSpec& f, const BlanketSpec& bl,
         level[k][static_cast<std::size_t>(jj * ni + ii)] =
             static_cast<std::int32_t>(mesh.n_nodes());
         fm.stitch_nodes.push_back(static_cast<std::int32_t>(mesh.n_nodes()));
-        mesh.coords.insert(mesh.coords.end(), {x, y, level_z(k)});
+        mesh.coords.insert(mesh.coords.end(), {x, y, L.level_z(k)});
       }
       ++fm.n_penetrations;
     }
@@ -263,9 +267,8 @@ void connect_stitch_to_tows(const fem::Mesh& mesh, const FabricSpec& f, const Bl
                             FabricModel& fm) {
   const double w = L.w, t = L.t, h_el = L.h_el;
   const int nw = L.nw;
-  const std::size_t n_levels = f.ply_angles_deg.size() + 1;
-  const double z_bot = bl.z0, z_top = bl.z0 + t * static_cast<double>(f.ply_angles_deg.size());
-  auto level_z = [&](std::size_t k) { return bl.z0 + t * static_cast<double>(k); };
+  const std::size_t n_levels = L.n_levels;
+  const double z_bot = L.level_z(0), z_top = L.level_z(n_levels - 1);
   // Each stitch node to the nearest node of every tow within reach on its ply boundary (on an
   // interface: the tows of both plies). The reach grows with the element length so that the nearest
   // node of a tow beside the gap is found; on meshes with elements longer than the tow pitch (the
@@ -284,7 +287,7 @@ void connect_stitch_to_tows(const fem::Mesh& mesh, const FabricSpec& f, const Bl
   auto on_a_level = [&](double z) {
     const double k = std::round((z - bl.z0) / t);
     return k >= 0 && k < static_cast<double>(n_levels) &&
-           std::abs(z - level_z(static_cast<std::size_t>(k))) <= z_tol;
+           std::abs(z - L.level_z(static_cast<std::size_t>(k))) <= z_tol;
   };
   for (std::size_t nd = 0; nd < tow_of_node.size(); ++nd) {
     if (tow_of_node[nd] < 0 || !on_a_level(mesh.coords[3 * nd + 2])) continue;
@@ -333,7 +336,7 @@ FabricModel generate_blanket(fem::Mesh& mesh, const FabricSpec& f, const Blanket
   std::vector<std::int32_t> axis_neighbour;
   mesh_tows(mesh, f, bl, L, prefix, fm, axis_neighbour);
   if (f.stitch == StitchPattern::None) return fm;
-  mesh_stitch(mesh, f, bl, L, file, size_key, prefix, fm);
+  mesh_stitch(mesh, f, L, file, size_key, prefix, fm);
   connect_stitch_to_tows(mesh, f, bl, L, axis_neighbour, fm);
   return fm;
 }

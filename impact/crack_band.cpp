@@ -13,12 +13,6 @@ void CrackBandRaise::add(int mode, double factor, std::int64_t element) {
   if (factor > max_factor[k]) max_factor[k] = factor, worst_element[k] = element;
 }
 
-bool CrackBandRaise::any() const {
-  for (auto n : elements)
-    if (n > 0) return true;
-  return false;
-}
-
 std::vector<std::string> CrackBandRaise::warnings() const {
   std::vector<std::string> out;
   for (std::size_t k = 0; k < elements.size(); ++k) {

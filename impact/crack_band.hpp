@@ -22,7 +22,6 @@ struct CrackBandRaise {
 
   /// Counts an element of mode m whose energy the law multiplies by `factor` (> 1).
   void add(int mode, double factor, std::int64_t element);
-  bool any() const;
   /// A warning line per raised mode, for the log (warnings.txt) and the report.
   std::vector<std::string> warnings() const;
   /// summary.json `crack_band_raised`: per raised mode {elements, mean_factor, max_factor};

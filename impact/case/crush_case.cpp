@@ -486,7 +486,7 @@ CrackBandRaise check_crack_band(const CaseReadContext& ctx) {
                       "\"raise\" beside the fracture energies)",
                       G, w[k].element, mat->name(), 1e3 * w[k].length, kModeNames[k],
                       1e3 * mat->max_element_length(static_cast<FailureMode>(md)),
-                      G * w[k].ratio * 1.001));
+                      G * w[k].ratio * kRaisedFailureRatio));
     }
   return raised;
 }
