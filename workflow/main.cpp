@@ -169,24 +169,66 @@ int run_run(const RunArgs& a, wf::Verbosity verbosity, int argc, char** argv) {
 
 struct CheckArgs {
   CLI::App* cmd = nullptr;
-  std::string case_file;
+  std::vector<std::string> case_files;
   std::vector<std::string> overrides;
 };
 
 void add_check(CLI::App& app, CheckArgs& a) {
   a.cmd = app.add_subcommand("check",
-                             "Validate a case without running it (exit 0, or 2 with the "
+                             "Validate cases without running them (exit 0, or 2 with the "
                              "file, key and allowed range)");
-  a.cmd->add_option("case", a.case_file, "Case file (TOML)")->required();
-  a.cmd->add_option("--set", a.overrides, "Override a case key: --set KEY=VALUE (repeatable)");
+  a.cmd->add_option("case", a.case_files, "Case files (TOML); several are checked one by one")
+      ->required();
+  a.cmd->add_option("--set", a.overrides,
+                    "Override a case key: --set KEY=VALUE (repeatable, applies to every case)");
 }
 
 // [case] kind -> its stage's check.
-int run_check(const CheckArgs& a) {
+int check_one(const std::string& case_file, const std::vector<std::string>& overrides) {
   wf::StageCall call;
-  call.case_file = a.case_file;
-  call.overrides = a.overrides;
+  call.case_file = case_file;
+  call.overrides = overrides;
   return wf::check_stage(call);
+}
+
+// Several case files: each checked as alone, its outcome on a line of its own; the exit code is
+// the worst of them (any other failure, else 2 for any bad input, else 0). MPI is started once
+// for all of them: what a check costs is mostly the start of the process and of MPI.
+int run_check(const CheckArgs& a) {
+  if (a.case_files.size() == 1) return check_one(a.case_files[0], a.overrides);
+  ncfsim::fem::PetscSession petsc;
+  if (const int code = wf::refuse_many_ranks()) return code;
+  int worst = wf::kSuccess;
+  std::size_t valid = 0, bad = 0;
+  for (const auto& file : a.case_files) {
+    int code = wf::kOtherError;
+    try {
+      code = check_one(file, a.overrides);
+    } catch (const ncfsim::InputError& e) {
+      code = bad_input(e);
+    } catch (const ncfsim::NumericalError& e) {
+      std::fprintf(stderr, "ncfsim: numerical failure: %s\n", e.what());
+      code = wf::kNumericalFailure;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "ncfsim: error: %s\n", e.what());
+    }
+    std::fflush(stderr);
+    std::printf("check %s: %s (exit %d)\n", file.c_str(),
+                code == wf::kSuccess    ? "valid"
+                : code == wf::kBadInput ? "bad input"
+                                        : "failed",
+                code);
+    std::fflush(stdout);
+    valid += code == wf::kSuccess;
+    bad += code == wf::kBadInput;
+    if (code != wf::kSuccess && code != wf::kBadInput)
+      worst = code;
+    else if (code == wf::kBadInput && worst == wf::kSuccess)
+      worst = code;
+  }
+  std::printf("checked %zu case files: %zu valid, %zu bad input, %zu failed\n", a.case_files.size(),
+              valid, bad, a.case_files.size() - valid - bad);
+  return worst;
 }
 
 // render, status, report, export: the output folder of a finished (or running) run.

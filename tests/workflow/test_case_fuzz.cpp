@@ -8,8 +8,10 @@
 // with their mutation and the output, and kept under the test's folder to rerun by hand.
 // The unmutated files are checked first, under the same rules. A file whose model has more than
 // 50 000 nodes (the paper-size meshes: ~5 s a check against ~0.3 s) has 2 keys mutated, the
-// others 4: about 2500 variants, ~0.2 s of CPU each, most of it the process start (the ~170
-// shared libraries of PETSc and VTK).
+// others 4: about 2500 variants. A check costs ~0.2 s of CPU alone, nearly all of it the start of
+// the process (the ~170 shared libraries of PETSc and VTK) and of MPI: the variants are checked
+// 16 to an `ncfsim check` (each file checked as alone, its exit code on its own line), and those
+// of a process that crashed, hung or ran out of memory again one to a process.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <toml++/toml.h>
@@ -144,7 +146,9 @@ std::vector<Variant> make_variants(const fs::path& root, const std::vector<fs::p
   return out;
 }
 
-pid_t start_check(const fs::path& file, const fs::path& log) {
+// `ncfsim check` of `files` in one process (a check costs mostly the start of the process and of
+// MPI: ~0.2 s of CPU against a few ms for the case itself), its output in `log`.
+pid_t start_check(const std::vector<fs::path>& files, const fs::path& log) {
   const pid_t pid = fork();
   if (pid == 0) {
     rlimit as{kAddressLimit, kAddressLimit};
@@ -156,7 +160,8 @@ pid_t start_check(const fs::path& file, const fs::path& log) {
     // No Open MPI daemon per check (a singleton forks one: ~0.2 s more per check here).
     ::setenv("OMPI_MCA_ess_singleton_isolated", "1", 1);
     use_own_mpi_session_base();
-    std::vector<std::string> args = {kExe.string(), "check", file.string()};
+    std::vector<std::string> args = {kExe.string(), "check"};
+    for (const auto& f : files) args.push_back(f.string());
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -166,28 +171,47 @@ pid_t start_check(const fs::path& file, const fs::path& log) {
   return pid;
 }
 
-// Every variant through `ncfsim check`, kParallel at a time: its exit code (-2: timed out) and,
-// where it is neither 0 nor 2, its output. The log of a variant that passes is removed with it
-// unless `keep` (the originals).
+// Every variant through `ncfsim check`, kBatch files to a process, kParallel processes at a time:
+// its exit code (-2: timed out) and, where it is neither 0 nor 2, its output. A process checking
+// several files ends each with "check FILE: ... (exit N)", which gives the file its code and its
+// share of the output; the files a process did not get to (it crashed, was killed for memory or
+// timed out) are checked again one to a process, so that what failed is the file's own exit.
+// The log of a variant that passes is removed with it unless `keep` (the originals).
 struct Outcome {
   int code = 0;
   std::string log;
 };
-std::vector<Outcome> check_all(const std::vector<Variant>& variants, bool keep) {
+constexpr std::size_t kBatch = 16;
+
+std::vector<Outcome> check_all(const std::vector<Variant>& variants, bool keep,
+                               std::size_t batch = kBatch) {
   std::vector<Outcome> out(variants.size());
   struct Running {
     pid_t pid;
-    std::size_t k;
+    std::vector<std::size_t> ks;
+    fs::path log;
     std::chrono::steady_clock::time_point start;
   };
   std::vector<Running> running;
+  std::vector<std::vector<std::size_t>> todo;  // the batches, in order
+  for (std::size_t k = 0; k < variants.size(); k += batch) {
+    todo.emplace_back();
+    for (std::size_t j = k; j < std::min(variants.size(), k + batch); ++j) todo.back().push_back(j);
+  }
   std::size_t next = 0;
-  auto log_of = [&](std::size_t k) { return fs::path(variants[k].file.string() + ".log"); };
-  while (next < variants.size() || !running.empty()) {
-    while (next < variants.size() && running.size() < static_cast<std::size_t>(kParallel)) {
-      running.push_back(
-          {start_check(variants[next].file, log_of(next)), next, std::chrono::steady_clock::now()});
-      ++next;
+  auto finish = [&](std::size_t k, int code, std::string log) {
+    out[k].code = code;
+    const bool failed = code != 0 && code != 2;
+    if (failed || keep) out[k].log = std::move(log);
+    if (!failed && !keep) fs::remove(variants[k].file);
+  };
+  while (next < todo.size() || !running.empty()) {
+    while (next < todo.size() && running.size() < static_cast<std::size_t>(kParallel)) {
+      const auto& ks = todo[next++];
+      std::vector<fs::path> files;
+      for (const std::size_t k : ks) files.push_back(variants[k].file);
+      const fs::path log = variants[ks.front()].file.string() + ".log";
+      running.push_back({start_check(files, log), ks, log, std::chrono::steady_clock::now()});
     }
     for (std::size_t r = 0; r < running.size();) {
       int status = 0;
@@ -199,22 +223,38 @@ std::vector<Outcome> check_all(const std::vector<Variant>& variants, bool keep) 
         ++r;
         continue;
       }
-      const std::size_t k = running[r].k;
-      if (done == 0) {
-        kill(running[r].pid, SIGKILL);
-        waitpid(running[r].pid, &status, 0);
-        out[k].code = -2;
-      } else {
-        out[k].code = exit_code(status);
-      }
-      remove_mpi_session_base(running[r].pid);
-      const bool failed = out[k].code != 0 && out[k].code != 2;
-      if (failed || keep) out[k].log = slurp(log_of(k));
-      if (!failed) {
-        fs::remove(log_of(k));
-        if (!keep) fs::remove(variants[k].file);
-      }
+      Running job = std::move(running[r]);
       running.erase(running.begin() + static_cast<std::ptrdiff_t>(r));
+      int code = -2;
+      if (done == 0) {
+        kill(job.pid, SIGKILL);
+        waitpid(job.pid, &status, 0);
+      } else {
+        code = exit_code(status);
+      }
+      remove_mpi_session_base(job.pid);
+      const std::string log = slurp(job.log);
+      fs::remove(job.log);
+      if (job.ks.size() == 1) {
+        finish(job.ks.front(), code, log);
+        continue;
+      }
+      // Each file's share of the log ends with its own line.
+      std::size_t from = 0;
+      std::vector<std::size_t> again;
+      for (const std::size_t k : job.ks) {
+        const std::string mark = "check " + variants[k].file.string() + ": ";
+        const std::size_t at = log.find(mark, from);
+        const std::size_t code_at = at == std::string::npos ? at : log.find("(exit ", at);
+        const std::size_t eol = code_at == std::string::npos ? code_at : log.find('\n', code_at);
+        if (eol == std::string::npos) {
+          again.push_back(k);
+          continue;
+        }
+        finish(k, std::stoi(log.substr(code_at + 6)), log.substr(from, eol + 1 - from));
+        from = eol + 1;
+      }
+      for (const std::size_t k : again) todo.push_back({k});
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }

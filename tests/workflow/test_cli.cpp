@@ -80,6 +80,29 @@ TEST(Cli, RefusesAnEmptyOutputFolderAndANanInterval) {
   EXPECT_NE(r.output.find("is a folder"), std::string::npos) << r.output;
 }
 
+// Several case files in one check: each as alone, its outcome on its own line, the exit code the
+// worst of them (2 where one is bad input), and the valid ones still reported valid.
+TEST(Cli, CheckOfSeveralFilesReportsEachAndExitsWithTheWorst) {
+  const std::string good = (kSource / "cases/verification/cantilever.toml").string();
+  const std::string pullout = (kSource / "cases/drape/tow_pullout.toml").string();
+  const std::string bad = (kSource / "tests/cases/bad/negative_modulus.toml").string();
+  Result r = run_cli({"check", good, pullout});
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("check " + good + ": valid (exit 0)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("check " + pullout + ": valid (exit 0)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("checked 2 case files: 2 valid, 0 bad input, 0 failed"),
+            std::string::npos)
+      << r.output;
+  r = run_cli({"check", good, bad, pullout});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("'material[0].youngs_modulus'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("check " + bad + ": bad input (exit 2)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("check " + pullout + ": valid (exit 0)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("checked 3 case files: 2 valid, 1 bad input, 0 failed"),
+            std::string::npos)
+      << r.output;
+}
+
 TEST(Cli, SetOverridesAreCheckedLikeTheFile) {
   const fs::path c = kSource / "cases/verification/cantilever.toml";
   Result r = run_cli({"check", c.string(), "--set", "time.end_tme=1"});
