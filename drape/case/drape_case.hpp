@@ -4,6 +4,7 @@
 // length, the bias-extension analytic curve). Called by the case orchestration (workflow/case)
 // between fem's readers (fem/case/fem_case.hpp), with the same reading context.
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,7 +24,9 @@ void register_drape_case_types(fem::CaseTypeRegistry& registry);
 /// One [[mesh.fabric]] between its generation and its parts' properties.
 struct FabricEntry {
   std::string name, path;  // path: its table, "mesh.fabric[0]"
+  std::string fabric;      // the [fabric.NAME] it reads its fabric keys from ("": its own)
   std::string tow_material, law_I, law_Lambda, law_legs;
+  std::map<std::string, std::string> key_paths;  // "tow_material", "stitch_law_I", ... -> path
   std::vector<double> angles;
   int elements_through_thickness = 1;
   FabricModel model;

@@ -1,4 +1,5 @@
 // [[mesh.fabric]] and the tow_biphase material type.
+#include <algorithm>
 #include <climits>
 #include <cmath>
 
@@ -66,7 +67,16 @@ FabricSpec read_fabric_spec(const TableReader& fb, const std::string& resolution
   f.elements_across_tow = read_int(fb, "elements_across_tow", 2);
   f.elements_through_thickness = read_int(fb, "elements_through_thickness", 1);
   f.element_length = fb.number("element_length", 0.0, {});
-  validate(f, fb.file().string(), fb.path());
+  try {
+    validate(f, fb.file().string(), fb.path());
+  } catch (const InputError& e) {
+    // A key the entry takes from its [fabric.NAME] is named there.
+    const std::string own = fb.path() + ".";
+    if (e.key().rfind(own, 0) != 0) throw;
+    const std::string key = e.key().substr(own.size());
+    if (fb.key_path(key) == e.key()) throw;
+    throw InputError(e.file(), fb.key_path(key), e.message(), e.value(), e.allowed());
+  }
   if (resolution == "coarse") {
     f.elements_across_tow = std::max(1, f.elements_across_tow / 2);
     f.element_length = 2 * (f.element_length > 0 ? f.element_length : f.tow_pitch());
@@ -97,10 +107,65 @@ void read_stitch_laws(const TableReader& fb, const FabricSpec& f, FabricEntry& f
   fe.connection.stiffness = fb.number("connection_stiffness", 0.0, Range::non_negative());
 }
 
-FabricEntry read_fabric(fem::CaseReadContext& ctx, const TableReader& fb) {
+// The keys a [[mesh.fabric]] entry may give beside the [fabric.NAME] it names: where the blanket
+// lies and how it is meshed, and how a specimen is cut from the fabric (its plies' angles and
+// wale direction to the test's axes, its stitch left out). Every other key is the fabric's own.
+bool specimen_key(const std::string& key) {
+  static const char* const keys[] = {"name",
+                                     "fabric",
+                                     "origin",
+                                     "size",
+                                     "elements_across_tow",
+                                     "elements_through_thickness",
+                                     "element_length",
+                                     "ply_angles_deg",
+                                     "stitch_direction_deg",
+                                     "stitch_edge_margin"};
+  return std::find(std::begin(keys), std::end(keys), key) != std::end(keys);
+}
+
+// `fabric = "NAME"`: the entry over [fabric.NAME] (a fabric file's, cases/fabrics/), so that the
+// virtual tests and the forming cases of a fabric read the same data. A fabric key given in both
+// is bad input: a case does not keep its own copy of its fabric (a variant changes it with
+// `set`, e.g. "fabric.NAME.tow_gap = ..."), except `stitch = "none"`, a specimen without stitch.
+TableReader over_its_fabric(const fem::CaseReadContext& ctx, const TableReader& fb,
+                            std::string& fabric) {
+  if (!fb.holds("fabric")) return fb;
+  fabric = fb.string("fabric");
+  const auto fabrics = ctx.root.table("fabric");
+  const auto own = fabrics ? fabrics->table(fabric) : std::nullopt;
+  if (!own) {
+    std::string known;
+    if (fabrics)
+      for (const auto& k : fabrics->keys()) known += (known.empty() ? "" : ", ") + k;
+    fb.fail("fabric", "no [fabric." + fabric + "] in the case or the files it includes" +
+                          (known.empty() ? std::string(" (include a fabric file: cases/fabrics/)")
+                                         : " (there are: " + known + ")"));
+  }
+  for (const auto& key : own->keys()) {
+    if (!fb.holds(key)) continue;
+    own->mark(key);  // read, though the entry's own value counts
+    if (specimen_key(key)) continue;
+    if (key == "stitch" && fb.string("stitch") == "none") continue;
+    fb.fail(key, "given both here and in [fabric." + fabric +
+                     "] (a case reads its fabric from one place: change it there, or give the "
+                     "change as fabric." +
+                     fabric + "." + key + " in --set or a variant's set)");
+  }
+  return fb.with_defaults(*own);
+}
+
+FabricEntry read_fabric(fem::CaseReadContext& ctx, const TableReader& entry) {
   FabricEntry fe;
-  fe.path = fb.path();
+  fe.path = entry.path();
+  const TableReader fb = over_its_fabric(ctx, entry, fe.fabric);
   fe.name = fb.string("name");
+  for (const char* k : {"tow_material", "stitch_law_I", "stitch_law_Lambda", "stitch_law_legs"})
+    fe.key_paths[k] = fb.key_path(k);
+  // The fabric's Coulomb coefficients, which its cases' contact pairs and tools refer to
+  // ("&fabric.NAME.friction_tow_tow"): checked here, with the rest of the fabric.
+  for (const char* k : {"friction_tow_tow", "friction_tow_tow_crossing", "friction_tool"})
+    if (fb.has(k)) (void)fb.number(k, Range::non_negative());
   const FabricSpec f = read_fabric_spec(fb, ctx.resolution);
   BlanketSpec bl;
   const auto origin = fb.vec3_or("origin", {0, 0, 0});
@@ -158,7 +223,7 @@ int named_index(const fem::CaseReadContext& ctx, const FabricEntry& fe,
                 const std::map<std::string, int>& names, const std::string& n,
                 const std::string& key) {
   if (!names.count(n))
-    throw InputError(ctx.file, fe.path + "." + key,
+    throw InputError(ctx.file, fe.key_paths.count(key) ? fe.key_paths.at(key) : fe.path + "." + key,
                      "no such " +
                          std::string(key == "tow_material" ? "[[material]]" : "[[bar_law]]") +
                          " '" + n + "'");
@@ -252,6 +317,16 @@ void register_drape_case_types(fem::CaseTypeRegistry& registry) {
 std::vector<FabricEntry> read_fabrics(fem::CaseReadContext& ctx, const TableReader& m) {
   std::vector<FabricEntry> fabrics;
   for (const auto& fb : m.tables("fabric")) fabrics.push_back(read_fabric(ctx, fb));
+  // A fabric no entry names (a case including its fabric file for the laws alone, e.g. the macro
+  // model's stitch) is not read; its keys are not unknown. Those of a fabric an entry names are
+  // read there, so that a misspelt key in a fabric file is found.
+  if (const auto all = ctx.root.table("fabric"))
+    for (const auto& name : all->keys()) {
+      const bool named = std::any_of(fabrics.begin(), fabrics.end(),
+                                     [&](const FabricEntry& fe) { return fe.fabric == name; });
+      if (const auto one = all->table(name); one && !named)
+        for (const auto& key : one->keys()) one->mark(key);
+    }
   return fabrics;
 }
 

@@ -279,7 +279,14 @@ TableReader::TableReader(CaseDocument& doc, const toml::table& table, std::strin
     : doc_(&doc), table_(table), path_(std::move(path)) {}
 
 std::string TableReader::key_path(std::string_view key) const {
+  if (!table_.contains(key) && defaults_ && defaults_->has(key)) return defaults_->key_path(key);
   return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+}
+
+TableReader TableReader::with_defaults(const TableReader& defaults) const {
+  TableReader r = *this;
+  r.defaults_ = std::make_shared<const TableReader>(defaults);
+  return r;
 }
 
 void TableReader::fail(std::string_view key, const std::string& message) const {
@@ -288,6 +295,7 @@ void TableReader::fail(std::string_view key, const std::string& message) const {
 
 const toml::node& TableReader::require(std::string_view key) const {
   const toml::node* n = table_.get(key);
+  if (!n && defaults_ && defaults_->has(key)) return defaults_->require(key);
   if (!n) fail(key, "missing (required)");
   doc_->mark_read(key_path(key));
   return *n;
@@ -296,6 +304,18 @@ const toml::node& TableReader::require(std::string_view key) const {
 double TableReader::as_number(std::string_view key, const toml::node& n) const {
   if (auto v = n.value_exact<double>()) return *v;
   if (auto v = n.value_exact<std::int64_t>()) return static_cast<double>(*v);
+  // "&fabric.saertex_pm45.friction_tow_tow": the number another key of the case gives (as
+  // LS-DYNA's &parameter), so that a datum shared by many tables is written once.
+  if (const auto ref = n.value_exact<std::string>(); ref && ref->size() > 1 && (*ref)[0] == '&') {
+    const std::string path = ref->substr(1);
+    const toml::node* r = doc_->root().at_path(path).node();
+    if (!r)
+      fail(key, "refers to '" + path + "', which the case and the files it includes do not give");
+    doc_->mark_read(path);
+    if (auto v = r->value_exact<double>()) return *v;
+    if (auto v = r->value_exact<std::int64_t>()) return static_cast<double>(*v);
+    fail(key, "refers to '" + path + "', which is " + type_name(*r) + ", not a number");
+  }
   fail(key, "must be a number, got " + type_name(n));
 }
 

@@ -3,15 +3,16 @@
 // built any key nobody read is reported as unknown (with the closest known key as a hint). Every
 // error is an InputError naming the file, the full key path, the value and the allowed range.
 // Used by every module's case reader (fem/case, drape/case, workflow/case).
+#include <toml++/toml.h>
+
 #include <array>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <toml++/toml.h>
 
 #include "fem/errors.hpp"
 
@@ -47,8 +48,16 @@ class TableReader {
 
   const std::string& path() const { return path_; }
   const std::filesystem::path& file() const { return doc_->file(); }
+  /// The key's path in the document: in this table, or in the defaults' where only they hold it.
   std::string key_path(std::string_view key) const;
-  bool has(std::string_view key) const { return table_.contains(key); }
+  bool has(std::string_view key) const {
+    return table_.contains(key) || (defaults_ && defaults_->has(key));
+  }
+  /// This table over `defaults`: a key this table lacks is read from (and reported in) the
+  /// defaults' table, e.g. a [[mesh.fabric]] entry over the [fabric.NAME] it names.
+  TableReader with_defaults(const TableReader& defaults) const;
+  /// Whether this table itself (not its defaults) holds `key`.
+  bool holds(std::string_view key) const { return table_.contains(key); }
   [[noreturn]] void fail(std::string_view key, const std::string& message) const;
 
   double number(std::string_view key, Range range) const;
@@ -83,6 +92,7 @@ class TableReader {
   CaseDocument* doc_;
   const toml::table& table_;
   std::string path_;
+  std::shared_ptr<const TableReader> defaults_;
 };
 
 }  // namespace ncfsim::fem
