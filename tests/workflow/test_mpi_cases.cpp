@@ -97,6 +97,21 @@ const std::vector<std::string> kHemisphereCi = {"mesh.fabric[0].elements_across_
                                                 "time.end_time=0.0012",
                                                 "time.history_interval=1.2e-5",
                                                 "time.quasi_static_from=0"};
+// With the fabric file's tow law (issue #43: 0.5 MPa compaction on the fibre-sheet spacing) the
+// blankholder squeezes the CI blank further as it closes and the stitch-to-tow joints slide: the
+// 2-rank run's last-bit differences first show in the joints' in-plane resultant and grow about
+// tenfold per 0.1 ms from 0.3 ms (2.5e-9 at 0.1 ms, 7.8e-8 at 0.3, 1.7e-7 at 0.6 ms, then up to
+// 7e-3 of the nearly-zero in-plane resultants' own scale at 1.2 ms), as in the pull-out (1e-6)
+// and the coupons (1e-4). The stitch-free control on the same law stays within 1e-7 over the
+// same 1.2 ms, so it is the joints' stick-slip, not the partition. So every column is compared
+// up to 0.3 ms, and over the whole 1.2 ms the energies and the normal forces within 1e-3
+// (measured: 1.2e-4 at most, the joints' normal resultant; energies 1.1e-5 to 3.4e-5).
+constexpr double kHemisphereUntil = 3e-4;
+constexpr double kHemisphereLate = 1e-3;
+const std::vector<std::string> kHemisphereLateColumns = {
+    "internal_energy_J",        "kinetic_energy_J",      "external_work_J",
+    "contact_energy_J",         "blankholder_force_z_N", "ply1__ply2_force_z_N",
+    "ncf_stitch_tow_force_z_N", "punch_displacement_m"};
 // The friction sleds at their regression test's coarse mesh, 10 ms (pressed, then pulled).
 const std::vector<std::string> kSled = {"mesh.resolution=coarse", "time.end_time=0.01",
                                         "time.history_interval=1e-4"};
@@ -151,7 +166,10 @@ const std::vector<Compared>& compared() {
       {"drape/tow_pullout.toml", {"time.end_time=0.004", "time.history_interval=4e-5"}, 1e-6},
       {"hemisphere/ci/drape.toml",
        {"time.end_time=0.0012", "time.history_interval=1.2e-5", "time.quasi_static_from=0"},
-       kRoundOff},
+       kRoundOff,
+       kHemisphereUntil,
+       kHemisphereLateColumns,
+       kHemisphereLate},
       {"hemisphere/drape_no_stitch.toml", kHemisphereCi, kRoundOff},
       // The frame's arms as walls push the edge tows of both ranks (measured: equal bit for bit).
       {"drape/picture_frame_unstitched.toml", kFrame6ms, kRoundOff},
