@@ -154,6 +154,15 @@ TEST(FabricFiles, AFabricKeyIsGivenInOnePlace) {
   EXPECT_EQ(r.substr(0, r.find(" | ")), "fabric.saertex_pm45.tow_gap") << r;
   r = key_of_refusal(pullout, {"fabric.saertex_pm45.tow_material='resin'"});
   EXPECT_EQ(r.substr(0, r.find(" | ")), "fabric.saertex_pm45.tow_material") << r;
+  // Fabric data that contradict each other: refused naming the fabric's key and the rule.
+  r = key_of_refusal(pullout, {"fabric.saertex_pm45.stitch_gauge=5e-3"});
+  EXPECT_EQ(r.rfind("fabric.saertex_pm45.", 0), 0u) << r;
+  EXPECT_NE(r.find("do not fall into the gaps between tows"), std::string::npos) << r;
+  r = key_of_refusal(pullout, {"fabric.saertex_pm45.tow_gap=4e-3"});
+  EXPECT_EQ(r.substr(0, r.find(" | ")), "fabric.saertex_pm45.tow_gap") << r;
+  EXPECT_NE(r.find("smaller than the tow width"), std::string::npos) << r;
+  r = key_of_refusal(pullout, {"fabric.saertex_pm45.friction_tool=-1"});
+  EXPECT_EQ(r.substr(0, r.find(" | ")), "fabric.saertex_pm45.friction_tool") << r;
   // How a specimen is cut is the case's: its ply angles, and its stitch left out.
   EXPECT_EQ(key_of_refusal(kSource / "cases/drape/friction_sled_tow_tow_0_90.toml",
                            {"mesh.fabric[1].ply_angles_deg=[0.0]"}),
