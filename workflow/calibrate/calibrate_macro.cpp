@@ -10,6 +10,7 @@
 
 #include "drape/fabric.hpp"
 #include "drape/stitch_calibration.hpp"
+#include "fem/case/toml_reader.hpp"
 #include "fem/errors.hpp"
 #include "workflow/output/output_files.hpp"
 #include "workflow/version.hpp"
@@ -219,29 +220,52 @@ struct PillarSource {
   bool tension_only = true;
 };
 
-PillarSource pillar_source(const std::filesystem::path& dir) {
-  const auto file = dir / "case.toml";
-  const std::string f = file.string();
-  toml::table root;
+// The positive run's case as it ran: its case file with its includes, base and --set resolved
+// (summary.json's case_file and overrides), where that file is still there; else the copy in the
+// run folder as it is.
+toml::table run_case(const std::filesystem::path& dir, std::string& f) {
+  f = (dir / "case.toml").string();
   try {
-    root = toml::parse_file(f);
+    const nlohmann::json s = read_json_file(dir / "summary.json");
+    const std::filesystem::path original = s.value("case_file", std::string());
+    if (!original.empty() && std::filesystem::is_regular_file(original)) {
+      f = original.string();
+      return fem::CaseDocument::load(original, s.value("overrides", std::vector<std::string>{}))
+          .root();
+    }
+  } catch (const std::exception&) {
+    f = (dir / "case.toml").string();  // no summary, or a case that no longer reads: the copy
+  }
+  try {
+    return toml::parse_file(f);
   } catch (const toml::parse_error& e) {
     throw InputError(f, "",
                      std::string("--stitch-bars reads the positive run's case: ") +
                          std::string(e.description()));
   }
+}
+
+PillarSource pillar_source(const std::filesystem::path& dir) {
+  std::string f;
+  const toml::table root = run_case(dir, f);
   const toml::array* fabrics = root["mesh"]["fabric"].as_array();
   if (!fabrics || fabrics->empty() || !fabrics->get(0)->is_table())
     throw InputError(f, "mesh.fabric", "--stitch-bars needs the meso frame's [[mesh.fabric]]");
-  const toml::table& fb = *fabrics->get(0)->as_table();
+  const toml::table& entry = *fabrics->get(0)->as_table();
+  // A blanket that names its fabric (fabric = "NAME") takes the fabric's keys from [fabric.NAME].
+  const toml::table* own = root["fabric"][entry["fabric"].value_or(std::string())].as_table();
+  auto key = [&](const char* k) {
+    return entry.contains(k) || !own ? toml::node_view<const toml::node>(entry[k])
+                                     : toml::node_view<const toml::node>((*own)[k]);
+  };
   PillarSource p;
-  p.law_name = fb["stitch_law_I"].value_or(std::string());
+  p.law_name = key("stitch_law_I").value_or(std::string());
   if (p.law_name.empty())
     throw InputError(f, "mesh.fabric[0].stitch_law_I", "--stitch-bars needs the pillar law");
   drape::FabricSpec spec;
-  spec.tow_width = fb["tow_width"].value_or(spec.tow_width);
-  spec.tow_gap = fb["tow_gap"].value_or(spec.tow_gap);
-  spec.stitch_gauge = fb["stitch_gauge"].value_or(0.0);
+  spec.tow_width = key("tow_width").value_or(spec.tow_width);
+  spec.tow_gap = key("tow_gap").value_or(spec.tow_gap);
+  spec.stitch_gauge = key("stitch_gauge").value_or(0.0);
   p.gauge = spec.gauge();
   if (const toml::array* laws = root["bar_law"].as_array())
     for (const auto& n : *laws) {
