@@ -37,33 +37,21 @@ namespace {
 
 struct FrameRun {
   nlohmann::json summary;
-  std::vector<std::pair<double, double>>
-      curve;  // (frame shear angle deg, normalised shear force N/m)
+  std::vector<std::pair<double, double>> curve;  // (frame shear angle deg, normalised shear force N/m)
 };
 
 FrameRun run_frame(const std::string& which, const std::vector<std::string>& extra = {}) {
   const fs::path out = fresh_dir("pf_" + which);
-  std::vector<std::string> args{
-      "-q",
-      "run",
-      (kSource / ("cases/drape/picture_frame_" + which + ".toml")).string(),
-      "-o",
-      out.string(),
-      "--set",
-      "output.figures=false",
-      "--set",
-      "output.report=false",
-      "--set",
-      "output.frames=none"};
+  std::vector<std::string> args{"-q", "run", (kSource / ("cases/drape/picture_frame_" + which + ".toml")).string(),
+                                "-o", out.string(), "--set", "output.figures=false", "--set", "output.report=false",
+                                "--set", "output.frames=none"};
   args.insert(args.end(), extra.begin(), extra.end());
   const Result r = run_cli(args);
   EXPECT_EQ(r.code, 0) << r.output;
   FrameRun run;
-  if (fs::exists(out / "summary.json"))
-    run.summary = nlohmann::json::parse(slurp(out / "summary.json"));
+  if (fs::exists(out / "summary.json")) run.summary = nlohmann::json::parse(slurp(out / "summary.json"));
   const History h = read_history(out / "history.csv");
-  const std::size_t ca = h.column("frame_shear_angle_deg"),
-                    cf = h.column("frame_normalised_shear_force_N_per_m");
+  const std::size_t ca = h.column("frame_shear_angle_deg"), cf = h.column("frame_normalised_shear_force_N_per_m");
   EXPECT_LT(cf, h.columns.size());
   if (cf < h.columns.size())
     for (const auto& v : h.rows) run.curve.emplace_back(v[ca], v[cf]);
@@ -145,15 +133,14 @@ double force_at(const FrameRun& r, double g) {
 // lower < value < upper of the reference row `q`.
 void expect_within(const Reference& ref, const std::string& q, double value) {
   const double lo = ref.at(q, "lower"), hi = ref.at(q, "upper");
-  EXPECT_TRUE(within(value, lo, hi)) << q << " = " << value << ", expected in (" << lo << ", " << hi
-                                     << ") (" << ref.file.string() << ")";
+  EXPECT_TRUE(within(value, lo, hi)) << q << " = " << value << ", expected in (" << lo << ", " << hi << ") ("
+                                     << ref.file.string() << ")";
 }
 
 void expect_completed(const FrameRun& r, const Reference& ref) {
   ASSERT_FALSE(r.summary.is_null());
   EXPECT_EQ(r.summary["status"], "completed");
-  expect_within(ref, "energy_balance_error_max",
-                r.summary["energy_balance_error_max"].get<double>());
+  expect_within(ref, "energy_balance_error_max", r.summary["energy_balance_error_max"].get<double>());
   ASSERT_FALSE(r.curve.empty());
   expect_within(ref, "final_shear_angle_deg", r.curve.back().first);
 }
