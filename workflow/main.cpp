@@ -48,6 +48,23 @@ int bad_input(const std::exception& e) {
   return wf::kBadInput;
 }
 
+// What a subcommand (or one case of a check) ends with: its own exit code, or that of the error
+// it threw, reported on stderr.
+template <class Body>
+int exit_code_of(const Body& body) {
+  try {
+    return body();
+  } catch (const ncfsim::InputError& e) {
+    return bad_input(e);
+  } catch (const ncfsim::NumericalError& e) {
+    std::fprintf(stderr, "ncfsim: numerical failure: %s\n", e.what());
+    return wf::kNumericalFailure;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ncfsim: error: %s\n", e.what());
+    return wf::kOtherError;
+  }
+}
+
 void require_output_folder(const std::filesystem::path& dir) {
   if (!std::filesystem::is_directory(dir))
     throw ncfsim::InputError(dir.string(), "", "not a folder (give the output folder of a run)");
@@ -201,17 +218,7 @@ int run_check(const CheckArgs& a) {
   int worst = wf::kSuccess;
   std::size_t valid = 0, bad = 0;
   for (const auto& file : a.case_files) {
-    int code = wf::kOtherError;
-    try {
-      code = check_one(file, a.overrides);
-    } catch (const ncfsim::InputError& e) {
-      code = bad_input(e);
-    } catch (const ncfsim::NumericalError& e) {
-      std::fprintf(stderr, "ncfsim: numerical failure: %s\n", e.what());
-      code = wf::kNumericalFailure;
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "ncfsim: error: %s\n", e.what());
-    }
+    const int code = exit_code_of([&]() -> int { return check_one(file, a.overrides); });
     std::fflush(stderr);
     std::printf("check %s: %s (exit %d)\n", file.c_str(),
                 code == wf::kSuccess    ? "valid"
@@ -558,7 +565,7 @@ int main(int argc, char** argv) {
   const wf::Verbosity verbosity = quiet     ? wf::Verbosity::Quiet
                                   : verbose ? wf::Verbosity::Verbose
                                             : wf::Verbosity::Normal;
-  try {
+  return exit_code_of([&]() -> int {
     if (*check.cmd) return run_check(check);
     if (*run.cmd) return run_run(run, verbosity, argc, argv);
     if (*compare.cmd) return run_compare(compare, verbosity);
@@ -569,14 +576,6 @@ int main(int argc, char** argv) {
     if (*folder.exporter) return run_export(folder.folder, folder.deck_format);
     if (*folder.status) return run_status(folder.folder);
     if (*folder.report) return run_report(folder.folder);
-  } catch (const ncfsim::InputError& e) {
-    return bad_input(e);
-  } catch (const ncfsim::NumericalError& e) {
-    std::fprintf(stderr, "ncfsim: numerical failure: %s\n", e.what());
-    return wf::kNumericalFailure;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "ncfsim: error: %s\n", e.what());
     return wf::kOtherError;
-  }
-  return wf::kOtherError;
+  });
 }
