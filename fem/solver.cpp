@@ -681,6 +681,9 @@ void ExplicitSolver::finish_cycle(const Cycle& c) {
   dt_prev_ = dt_new;
   dt_ = dt_new;
   ++cycle_;
+  // What the first cycles allocated (the contacts' first sort, the output's buffers) lies in new
+  // mappings that the set-up's advice did not reach.
+  if (++cycles_here_ == kHugePageSecondLook) huge_pages_ = advise_huge_pages();
 }
 
 }  // namespace ncfsim::fem

@@ -92,7 +92,8 @@ class ExplicitSolver {
 
   double time() const { return t_; }
   double time_step() const { return dt_; }
-  /// What the set-up got of 2 MB pages for the model's arrays (fem/huge_pages.hpp).
+  /// What the set-up got of 2 MB pages for the model's arrays (fem/huge_pages.hpp), and from
+  /// the 100th cycle of this process what it has after a second advice.
   const HugePageAdvice& huge_pages() const { return huge_pages_; }
   std::int64_t cycle() const { return cycle_; }
   const EnergyBalance& energy() const { return energy_; }
@@ -312,6 +313,8 @@ class ExplicitSolver {
   std::vector<std::uint8_t> fixed_mask_;  // [3*n] 1 where a DOF is fixed
   double t_ = 0, dt_ = 0, dt_prev_ = 0, dt_initial_ = 0;
   HugePageAdvice huge_pages_;
+  static constexpr std::int64_t kHugePageSecondLook = 100;  // cycles of this process before the
+  std::int64_t cycles_here_ = 0;                            // second advice (a resume too)
   // Sum over the cycles of a bound on this rank's largest node displacement in each (m): the
   // rigid tools' proximity cull compares its growth with their margin (not checkpointed: after a
   // resume the tools check once and start from there).

@@ -112,47 +112,6 @@ toml::table parse_case_file(const std::filesystem::path& file) {
   }
 }
 
-// A variant of another case ([case] base = "other.toml", set = ["key=value", ...]): the base
-// case with the variant's changes, named and described by the variant. It holds only [case], so
-// that each of its changes is one visible line and the base stays the one description of the rest.
-toml::table resolve_base(const std::filesystem::path& file, toml::table root, int depth) {
-  const std::string fname = file.string();
-  const toml::table* c = root["case"].as_table();
-  if (!c || !c->contains("base")) return root;
-  const auto base = (*c)["base"].value<std::string>();
-  if (!base || base->empty()) throw InputError(fname, "case.base", "must be the path of a case file");
-  if (depth >= 4) throw InputError(fname, "case.base", "bases nest more than 4 deep (a cycle?)");
-  for (const auto& [k, v] : root)
-    if (k.str() != "case")
-      throw InputError(fname, std::string(k.str()),
-                       "a case with case.base holds only [case]: give its changes in case.set "
-                       "(e.g. set = [\"mesh.fabric[0].stitch = 'none'\"])");
-  std::vector<std::string> sets;
-  if (c->contains("set")) {
-    const toml::array* a = (*c)["set"].as_array();
-    if (!a) throw InputError(fname, "case.set", "must be an array of \"key=value\" strings");
-    for (const auto& e : *a) {
-      const auto s = e.value<std::string>();
-      if (!s) throw InputError(fname, "case.set", "must be an array of \"key=value\" strings");
-      sets.push_back(*s);
-    }
-  }
-  std::filesystem::path base_file = *base;
-  if (base_file.is_relative()) base_file = file.parent_path() / base_file;
-  if (!std::filesystem::is_regular_file(base_file))
-    throw InputError(fname, "case.base", "no such case file: " + base_file.string());
-  CaseDocument b = CaseDocument::load_resolved(base_file, sets, depth + 1);
-  toml::table out = b.root();
-  toml::table* oc = out["case"].as_table();
-  if (!oc) {
-    out.insert("case", toml::table{});
-    oc = out["case"].as_table();
-  }
-  for (const auto& [k, v] : *c)
-    if (k.str() != "base" && k.str() != "set") oc->insert_or_assign(k.str(), v);
-  return out;
-}
-
 // Merges `inc` (from file `from`) into `into`: keys absent from `into` are added, tables merge
 // key by key, arrays of tables are the included entries first, then the case's own; any other
 // key given in both is an error (a case does not silently change what it includes).
@@ -212,18 +171,10 @@ toml::table resolve_includes(const std::filesystem::path& file, toml::table root
   return root;
 }
 
-}  // namespace
-
-CaseDocument CaseDocument::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-  return load_resolved(file, overrides, 0);
-}
-
-CaseDocument CaseDocument::load_resolved(const std::filesystem::path& file,
-                                         const std::vector<std::string>& overrides, int depth) {
-  CaseDocument doc;
-  doc.file_ = file;
-  const std::string fname = file.string();
-  doc.root_ = resolve_base(file, resolve_includes(file, parse_case_file(file), 0), depth);
+// `--set` and a variant's `set`: "a.b[2].c=value", the value in TOML syntax or a bare word (a
+// string); tables on the way are made as needed.
+void apply_overrides(toml::table& root, const std::vector<std::string>& overrides,
+                     const std::string& fname) {
   for (const std::string& ov : overrides) {
     const auto eq = ov.find('=');
     if (eq == std::string::npos || eq == 0)
@@ -238,7 +189,7 @@ CaseDocument CaseDocument::load_resolved(const std::filesystem::path& file,
     for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
     if (parts.empty() || std::any_of(parts.begin(), parts.end(), [](auto& p) { return p.empty(); }))
       throw InputError(fname, key, "--set: malformed key");
-    toml::table* t = ensure_table(doc.root_, parts, parts.size() - 1, fname, key);
+    toml::table* t = ensure_table(root, parts, parts.size() - 1, fname, key);
     toml::table parsed;
     try {
       parsed = toml::parse("v = " + value);
@@ -247,6 +198,72 @@ CaseDocument CaseDocument::load_resolved(const std::filesystem::path& file,
     }
     t->insert_or_assign(parts.back(), *parsed.get("v"));
   }
+}
+
+// A variant of another case ([case] base = "other.toml", set = ["key=value", ...]): the base
+// case, with the sections of the variant's own `include` files added (another fabric to drape),
+// then the variant's changes, named and described by the variant. It holds only [case] (and
+// `include`), so that each of its changes is one visible line and the base stays the one
+// description of the rest.
+toml::table resolve_base(const std::filesystem::path& file, toml::table root, int depth) {
+  const std::string fname = file.string();
+  const toml::table* c = root["case"].as_table();
+  if (!c || !c->contains("base")) return resolve_includes(file, std::move(root), 0);
+  const auto base = (*c)["base"].value<std::string>();
+  if (!base || base->empty()) throw InputError(fname, "case.base", "must be the path of a case file");
+  if (depth >= 4) throw InputError(fname, "case.base", "bases nest more than 4 deep (a cycle?)");
+  for (const auto& [k, v] : root)
+    if (k.str() != "case" && k.str() != "include")
+      throw InputError(fname, std::string(k.str()),
+                       "a case with case.base holds only [case] (and include): give its changes in "
+                       "case.set (e.g. set = [\"mesh.fabric[0].stitch = 'none'\"])");
+  std::vector<std::string> sets;
+  if (c->contains("set")) {
+    const toml::array* a = (*c)["set"].as_array();
+    if (!a) throw InputError(fname, "case.set", "must be an array of \"key=value\" strings");
+    for (const auto& e : *a) {
+      const auto s = e.value<std::string>();
+      if (!s) throw InputError(fname, "case.set", "must be an array of \"key=value\" strings");
+      sets.push_back(*s);
+    }
+  }
+  std::filesystem::path base_file = *base;
+  if (base_file.is_relative()) base_file = file.parent_path() / base_file;
+  if (!std::filesystem::is_regular_file(base_file))
+    throw InputError(fname, "case.base", "no such case file: " + base_file.string());
+  CaseDocument b = CaseDocument::load_resolved(base_file, {}, depth + 1);
+  toml::table out = b.root();
+  // The variant's includes, merged as the base's own are: a key the base gives too is bad input.
+  if (root.contains("include")) {
+    toml::table inc;
+    inc.insert("include", *root.get("include"));
+    inc = resolve_includes(file, std::move(inc), 0);
+    merge_included(out, inc, fname, "the includes of " + fname, "");
+  }
+  apply_overrides(out, sets, fname);
+  toml::table* oc = out["case"].as_table();
+  if (!oc) {
+    out.insert("case", toml::table{});
+    oc = out["case"].as_table();
+  }
+  for (const auto& [k, v] : *c)
+    if (k.str() != "base" && k.str() != "set") oc->insert_or_assign(k.str(), v);
+  return out;
+}
+
+}  // namespace
+
+CaseDocument CaseDocument::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  return load_resolved(file, overrides, 0);
+}
+
+CaseDocument CaseDocument::load_resolved(const std::filesystem::path& file,
+                                         const std::vector<std::string>& overrides, int depth) {
+  CaseDocument doc;
+  doc.file_ = file;
+  const std::string fname = file.string();
+  doc.root_ = resolve_base(file, parse_case_file(file), depth);
+  apply_overrides(doc.root_, overrides, fname);
   return doc;
 }
 

@@ -237,6 +237,21 @@ TEST(CaseReading, VariantCaseIsItsBaseWithItsChanges) {
             "time.end_time");
   EXPECT_EQ(key_of_error(write_case("variant_missing", "[case]\nbase = \"nowhere.toml\"\n")), "case.base");
   EXPECT_EQ(key_of_error(write_case("variant_loop", "[case]\nbase = \"variant_loop.toml\"\n")), "case.base");
+
+  // A variant's own include adds sections to its base (another fabric), before its set, which may
+  // change what it included; a key the base gives too is bad input naming it.
+  write_case("variant_extra", "[fabric.other]\ntow_gap = 1e-4\n[[material]]\nname = \"other_tow\"\n");
+  const auto with_inc = fem::CaseDocument::load(
+      write_case("variant_inc", "include = [\"variant_extra.toml\"]\n[case]\nbase = \"variant_base.toml\"\n"
+                                "set = [\"fabric.other.tow_gap = 2e-4\"]\n"),
+      {});
+  EXPECT_DOUBLE_EQ(with_inc.root()["fabric"]["other"]["tow_gap"].value<double>().value(), 2e-4);
+  EXPECT_EQ(with_inc.root()["material"][0]["name"].value<std::string>(), "other_tow");
+  EXPECT_DOUBLE_EQ(with_inc.root()["time"]["end_time"].value<double>().value(), 0.01);  // the base's
+  write_case("variant_clash", "[time]\nend_time = 0.5\n");
+  EXPECT_EQ(key_of_error(write_case("variant_inc_clash",
+                                    "include = \"variant_clash.toml\"\n[case]\nbase = \"variant_base.toml\"\n")),
+            "time.end_time");
 }
 
 // time.quasi_static_from lies in [0, end_time): 0 (the whole run) is allowed, end_time is not.

@@ -240,6 +240,7 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
   r.summary["status"] = r.status;
   r.summary["wall_seconds"] = r.wall_seconds();
   r.summary["peak_memory_MB"] = fem::peak_resident_mb();
+  r.summary["huge_pages_MB"] = static_cast<double>(s.huge_pages().huge_bytes >> 20);
   r.summary["frames"] = frames.written();
   r.summary["frame_write_errors"] = frames.errors();
   add_state_summary(s, r.max_error(), r.summary);
