@@ -178,6 +178,7 @@ class PenaltyContact final : public ContactAlgorithm {
   /// cycle. The force pass visits only these (on a fabric ~0.1 contacts per node: a pass over
   /// every surface node's records, on every rank over the whole model's, was most of its cost).
   std::vector<std::uint64_t> live_;
+  std::vector<std::int32_t> live_list_;  // the facets of live_ in a cycle's force pass, in order
   std::vector<FacetState> facet_state_;      // [n_facet]
   std::vector<FacetState> facet_state_old_;  // before the last sort (carried over)
   std::vector<std::int32_t> facet_start_;    // [n_snode + 1] first facet of each surface node

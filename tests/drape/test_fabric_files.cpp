@@ -133,6 +133,47 @@ TEST(FabricFiles, EveryCaseOfTheFabricReadsTheOneFabricFile) {
   EXPECT_GE(blankets, 14u);
 }
 
+// The second fabric (a 0/90 chain-stitched NCF, issue #43 item 4) through the same readers: its
+// cases (cases/fabrics/biax_0_90_chain/) name it, read its laws from its file and take its Coulomb
+// coefficients by reference; its hemisphere is the +-45 fabric's CI case with the fabric swapped
+// (a variant that includes the second fabric's file), and the generator makes a chain stitch:
+// pillars along the wales on both faces, one part for them, no underlap part.
+TEST(FabricFiles, TheSecondFabricsCasesReadItsFile) {
+  const fs::path file = kSource / "cases/fabrics/biax_0_90_chain.toml";
+  const toml::table fabric = toml::parse_file(file.string());
+  const auto* spec = fabric["fabric"]["biax_0_90_chain"].as_table();
+  ASSERT_NE(spec, nullptr);
+  const fs::path hemisphere = kSource / "cases/fabrics/biax_0_90_chain/hemisphere_ci.toml";
+  const fem::CaseDocument doc = fem::CaseDocument::load(hemisphere, {});
+  const toml::table& t = doc.root();
+  EXPECT_EQ(*t["fabric"]["biax_0_90_chain"].as_table(), *spec);
+  EXPECT_EQ(t["mesh"]["fabric"][0]["fabric"].value<std::string>(), "biax_0_90_chain");
+  EXPECT_EQ(*entry_named(t, "material", "dry_tow_24k"),
+            *entry_named(fabric, "material", "dry_tow_24k"));
+  EXPECT_EQ(*entry_named(t, "bar_law", "stitch_pillar_76dtex"),
+            *entry_named(fabric, "bar_law", "stitch_pillar_76dtex"));
+  for (std::size_t k = 0; k < 5; ++k)
+    EXPECT_EQ(t["tool"][k]["friction"].value<std::string>(),
+              "&fabric.biax_0_90_chain.friction_tool")
+        << k;
+  for (std::size_t k = 0; k < 3; ++k)
+    EXPECT_EQ(t["contact"][0]["pair"][k]["friction"].value<std::string>().value_or("").rfind(
+                  "&fabric.biax_0_90_chain.friction_tow_tow", 0),
+              0u)
+        << k;
+
+  const auto ec = workflow::load_engine_case(hemisphere, {});
+  const auto& mesh = ec.model.mesh;
+  std::set<std::string> parts(mesh.part_names.begin(), mesh.part_names.end());
+  EXPECT_TRUE(parts.count("ncf_stitch_I"));
+  EXPECT_TRUE(parts.count("ncf_stitch_legs"));
+  EXPECT_FALSE(parts.count("ncf_stitch_Lambda")) << "a chain stitch has no underlap";
+  // The blanket has the tows of a 5.08 mm pitch: fewer than the +-45 fabric's 3.32 mm on the
+  // same 270 mm blank.
+  const auto pm45 = workflow::load_engine_case(kSource / "cases/hemisphere/ci/drape.toml", {});
+  EXPECT_LT(mesh.n_nodes(), pm45.model.mesh.n_nodes());
+}
+
 std::string key_of_refusal(const fs::path& file, const std::vector<std::string>& sets) {
   try {
     (void)workflow::load_engine_case(file, sets);
