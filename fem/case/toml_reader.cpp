@@ -234,11 +234,15 @@ toml::table resolve_base(const std::filesystem::path& file, toml::table root, in
   CaseDocument b = CaseDocument::load_resolved(base_file, {}, depth + 1);
   toml::table out = b.root();
   // The variant's includes, merged as the base's own are: a key the base gives too is bad input.
-  if (root.contains("include")) {
+  if (const toml::node* include = root.get("include")) {
     toml::table inc;
-    inc.insert("include", *root.get("include"));
-    inc = resolve_includes(file, std::move(inc), 0);
-    merge_included(out, inc, fname, "the includes of " + fname, "");
+    inc.insert("include", *include);
+    inc = resolve_includes(file, std::move(inc), 0);  // checks the list's form and files
+    std::string names;
+    if (const auto one = include->value<std::string>()) names = *one;
+    if (const toml::array* a = include->as_array())
+      for (const auto& e : *a) names += (names.empty() ? "" : ", ") + e.value_or(std::string());
+    merge_included(out, inc, base_file.string(), names + " (included by " + fname + ")", "");
   }
   apply_overrides(out, sets, fname);
   toml::table* oc = out["case"].as_table();

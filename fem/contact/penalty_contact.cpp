@@ -670,84 +670,82 @@ void PenaltyContact::add_forces(const double* x, const double* v, const double*,
   const std::int32_t* lf = live_list_.data();
   const std::size_t n_live = live_list_.size();
   constexpr std::size_t kHitAhead = 16, kCornerAhead = 8, kVelocityAhead = 4;  // facets
-  {
-    for (std::size_t k = 0; k < n_live; ++k) {
-      if (k + kHitAhead < n_live) {
-        __builtin_prefetch(best + lf[k + kHitAhead], 1);
-        __builtin_prefetch(state + lf[k + kHitAhead], 1);
-      }
-      if (k + kCornerAhead < n_live)
-        if (const std::int32_t q = best[lf[k + kCornerAhead]].seg; q >= 0)
-          __builtin_prefetch(sn + 4 * static_cast<std::size_t>(q));
-      if (k + kVelocityAhead < n_live)
-        if (const std::int32_t q = best[lf[k + kVelocityAhead]].seg; q >= 0)
-          for (int a = 0; a < 4; ++a) {
-            const auto c = static_cast<std::size_t>(sn[4 * static_cast<std::size_t>(q) + a]);
-            __builtin_prefetch(v + 3 * c);
-            __builtin_prefetch(m_node + c);
-          }
-      const auto fi = static_cast<std::size_t>(lf[k]);
-      const std::size_t w = fi >> 6;
-      const auto bit = static_cast<unsigned>(fi & 63);
-      const ForceNode R = fnode[facet_node[fi]];
-      const auto i = static_cast<std::size_t>(R.mesh_node);
-      FacetState& S = state[fi];
-      double* ft = S.tang;
-      const std::int32_t was = S.last;
-      const BestHit F = best[fi];
-      best[fi] = BestHit{};  // ready for the next cycle's narrow phase
-      best[fi].last = F.seg;
-      S.last = F.seg;
-      if (F.seg < 0) {
-        if (was >= 0) S = FacetState{};  // else zero
-        live[w] &= ~(std::uint64_t{1} << bit);
-        continue;
-      }
-      const double m_s = m_node[i];
-      const double vsx = v[3 * i], vsy = v[3 * i + 1], vsz = v[3 * i + 2];
-      const std::size_t row = static_cast<std::size_t>(R.group) * ng;
-      ++n_active;
-      n_changes += (was >= 0) & (was != F.seg);
-      const auto s = static_cast<std::size_t>(F.seg);
-      const std::int32_t* corner = sn + 4 * s;
-      const int l = B.n++;
-      double N[4];
-      segment_shape(F.xi, F.eta, N);
-      double m_m = 0, vmx = 0, vmy = 0, vmz = 0;
-      for (int a = 0; a < 4; ++a) {
-        const auto q = 3 * static_cast<std::size_t>(corner[a]);
-        m_m += N[a] * m_node[corner[a]];
-        vmx += N[a] * v[q], vmy += N[a] * v[q + 1], vmz += N[a] * v[q + 2];
-        B.N[a][l] = N[a];
-      }
-      // The spring acts on the penetration past an offset, so that the force never jumps: a node
-      // found already behind the surface (it came round a tow edge, or through a seam between
-      // tows) starts from zero force, and at a switch to another segment the elastic part of
-      // the penetration carries over. The offset only ever shrinks while the contact lasts (the
-      // node withdrawing takes it with it), so the law can lose energy but never create it.
-      const double gap = F.gap - (F.seg == was ? kStick * depth_[s] : 0.0);
-      const double pen_geo = thick - gap;
-      double off = was < 0        ? pen_geo
-                   : was != F.seg ? std::max(pen_geo - S.elastic, 0.0)
-                                  : std::min(S.offset, pen_geo);
-      off = std::max(off, 0.0);
-      S.offset = off;
-      const double pen = pen_geo - off;
-      S.elastic = pen;
-      if (pen_geo > max_pen) max_pen = pen_geo, max_pen_node = static_cast<std::int32_t>(i);
-      const std::size_t cell = row + static_cast<std::size_t>(sg[s]);
-      B.pen[l] = pen;
-      B.nx[l] = F.n[0], B.ny[l] = F.n[1], B.nz[l] = F.n[2];
-      B.m_s[l] = m_s, B.m_m[l] = m_m;
-      B.rx[l] = vsx - vmx, B.ry[l] = vsy - vmy, B.rz[l] = vsz - vmz;
-      B.mu[l] = mu_of[cell];
-      B.tx[l] = ft[0], B.ty[l] = ft[1], B.tz[l] = ft[2];
-      B.slave[l] = static_cast<std::int32_t>(i);
-      B.seg[l] = static_cast<std::int32_t>(s);
-      B.state[l] = static_cast<std::int32_t>(fi);
-      B.cell[l] = static_cast<std::int32_t>(cell);
-      if (B.n == kContactBatch) flush();
+  for (std::size_t k = 0; k < n_live; ++k) {
+    if (k + kHitAhead < n_live) {
+      __builtin_prefetch(best + lf[k + kHitAhead], 1);
+      __builtin_prefetch(state + lf[k + kHitAhead], 1);
     }
+    if (k + kCornerAhead < n_live)
+      if (const std::int32_t q = best[lf[k + kCornerAhead]].seg; q >= 0)
+        __builtin_prefetch(sn + 4 * static_cast<std::size_t>(q));
+    if (k + kVelocityAhead < n_live)
+      if (const std::int32_t q = best[lf[k + kVelocityAhead]].seg; q >= 0)
+        for (int a = 0; a < 4; ++a) {
+          const auto c = static_cast<std::size_t>(sn[4 * static_cast<std::size_t>(q) + a]);
+          __builtin_prefetch(v + 3 * c);
+          __builtin_prefetch(m_node + c);
+        }
+    const auto fi = static_cast<std::size_t>(lf[k]);
+    const std::size_t w = fi >> 6;
+    const auto bit = static_cast<unsigned>(fi & 63);
+    const ForceNode R = fnode[facet_node[fi]];
+    const auto i = static_cast<std::size_t>(R.mesh_node);
+    FacetState& S = state[fi];
+    double* ft = S.tang;
+    const std::int32_t was = S.last;
+    const BestHit F = best[fi];
+    best[fi] = BestHit{};  // ready for the next cycle's narrow phase
+    best[fi].last = F.seg;
+    S.last = F.seg;
+    if (F.seg < 0) {
+      if (was >= 0) S = FacetState{};  // else zero
+      live[w] &= ~(std::uint64_t{1} << bit);
+      continue;
+    }
+    const double m_s = m_node[i];
+    const double vsx = v[3 * i], vsy = v[3 * i + 1], vsz = v[3 * i + 2];
+    const std::size_t row = static_cast<std::size_t>(R.group) * ng;
+    ++n_active;
+    n_changes += (was >= 0) & (was != F.seg);
+    const auto s = static_cast<std::size_t>(F.seg);
+    const std::int32_t* corner = sn + 4 * s;
+    const int l = B.n++;
+    double N[4];
+    segment_shape(F.xi, F.eta, N);
+    double m_m = 0, vmx = 0, vmy = 0, vmz = 0;
+    for (int a = 0; a < 4; ++a) {
+      const auto q = 3 * static_cast<std::size_t>(corner[a]);
+      m_m += N[a] * m_node[corner[a]];
+      vmx += N[a] * v[q], vmy += N[a] * v[q + 1], vmz += N[a] * v[q + 2];
+      B.N[a][l] = N[a];
+    }
+    // The spring acts on the penetration past an offset, so that the force never jumps: a node
+    // found already behind the surface (it came round a tow edge, or through a seam between
+    // tows) starts from zero force, and at a switch to another segment the elastic part of
+    // the penetration carries over. The offset only ever shrinks while the contact lasts (the
+    // node withdrawing takes it with it), so the law can lose energy but never create it.
+    const double gap = F.gap - (F.seg == was ? kStick * depth_[s] : 0.0);
+    const double pen_geo = thick - gap;
+    double off = was < 0        ? pen_geo
+                 : was != F.seg ? std::max(pen_geo - S.elastic, 0.0)
+                                : std::min(S.offset, pen_geo);
+    off = std::max(off, 0.0);
+    S.offset = off;
+    const double pen = pen_geo - off;
+    S.elastic = pen;
+    if (pen_geo > max_pen) max_pen = pen_geo, max_pen_node = static_cast<std::int32_t>(i);
+    const std::size_t cell = row + static_cast<std::size_t>(sg[s]);
+    B.pen[l] = pen;
+    B.nx[l] = F.n[0], B.ny[l] = F.n[1], B.nz[l] = F.n[2];
+    B.m_s[l] = m_s, B.m_m[l] = m_m;
+    B.rx[l] = vsx - vmx, B.ry[l] = vsy - vmy, B.rz[l] = vsz - vmz;
+    B.mu[l] = mu_of[cell];
+    B.tx[l] = ft[0], B.ty[l] = ft[1], B.tz[l] = ft[2];
+    B.slave[l] = static_cast<std::int32_t>(i);
+    B.seg[l] = static_cast<std::int32_t>(s);
+    B.state[l] = static_cast<std::int32_t>(fi);
+    B.cell[l] = static_cast<std::int32_t>(cell);
+    if (B.n == kContactBatch) flush();
   }
   flush();
   dissipation_ += dissipated;
