@@ -14,6 +14,14 @@ inline nlohmann::json summary(const fs::path& out) {
   return nlohmann::json::parse(slurp(out / "summary.json"));
 }
 
+/// summary.json keys that describe the process, not the results: a stopped and resumed run
+/// differs from an uninterrupted one in them (the pages the kernel gave, the clock, the memory,
+/// the command line), so the comparisons of results skip them.
+inline bool is_process_fact(const std::string& key) {
+  return key == "wall_seconds" || key == "peak_memory_MB" || key == "huge_pages_MB" ||
+         key == "timers_s" || key == "overrides" || key == "mpi_per_rank";
+}
+
 /// How many times `what` occurs in `text`.
 inline int count(const std::string& text, const std::string& what) {
   int n = 0;

@@ -65,8 +65,7 @@ void expect_same_results(const fs::path& u, const fs::path& r) {
   EXPECT_EQ(sr["status"], "completed");
   ASSERT_TRUE(sr.contains("resumed"));
   for (const auto& [key, value] : su.items()) {
-    if (key == "wall_seconds" || key == "peak_memory_MB" || key == "timers_s" || key == "overrides")
-      continue;
+    if (is_process_fact(key)) continue;
     EXPECT_EQ(value, sr[key]) << key;
   }
   const fem::io::ResultReader hu(u / "results.h5"), hr(r / "results.h5");
@@ -183,7 +182,7 @@ TEST(CliRegressionResume, WorkflowStoppedInAStageResumesIt) {
   const auto s1 = summary(w1 / "b"), s2 = summary(w2 / "b");
   EXPECT_EQ(s2["status"], "completed");
   for (const auto& [key, value] : s1.items()) {
-    if (value.is_number_float() && key != "wall_seconds" && key != "peak_memory_MB") {
+    if (value.is_number_float() && !is_process_fact(key)) {
       EXPECT_EQ(value, s2[key]) << key;
     }
   }
@@ -312,8 +311,7 @@ figures = false
   EXPECT_GT(h.rows.back()[c_failed], failed_at_stop) << "no element failed after the restart";
   const auto sr = summary(r);
   for (const auto& [key, value] : su.items()) {
-    if (key == "wall_seconds" || key == "peak_memory_MB" || key == "timers_s" || key == "overrides")
-      continue;
+    if (is_process_fact(key)) continue;
     EXPECT_EQ(value, sr[key]) << key;
   }
   fs::remove_all(dir);
