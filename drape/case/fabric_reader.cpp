@@ -166,6 +166,9 @@ FabricEntry read_fabric(fem::CaseReadContext& ctx, const TableReader& entry) {
   // ("&fabric.NAME.friction_tow_tow"): checked here, with the rest of the fabric.
   for (const char* k : {"friction_tow_tow", "friction_tow_tow_crossing", "friction_tool"})
     if (fb.has(k)) (void)fb.number(k, Range::non_negative());
+  // The tow's ASTM D1388 bending length, the target its E11f is calibrated to (a calibration
+  // stage refers to it).
+  if (fb.has("tow_bending_length")) (void)fb.number("tow_bending_length", Range::positive());
   const FabricSpec f = read_fabric_spec(fb, ctx.resolution);
   BlanketSpec bl;
   const auto origin = fb.vec3_or("origin", {0, 0, 0});

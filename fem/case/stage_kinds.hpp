@@ -9,6 +9,7 @@ inline constexpr const char* kEngine = "engine";
 inline constexpr const char* kCrush = "crush";
 inline constexpr const char* kKinematicDrape = "kinematic_drape";
 inline constexpr const char* kTransfer = "transfer";
+inline constexpr const char* kCalibration = "calibration";
 inline constexpr const char* kWorkflow = "workflow";
 
 }  // namespace ncfsim::fem::stage_kind

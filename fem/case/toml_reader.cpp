@@ -271,6 +271,71 @@ CaseDocument CaseDocument::load_resolved(const std::filesystem::path& file,
   return doc;
 }
 
+void CaseDocument::apply_laws_files() {
+  toml::table* c = root_["case"].as_table();
+  if (!c || !c->contains("laws")) return;
+  mark_read("case.laws");
+  std::vector<std::string> files;
+  const toml::node& n = *c->get("laws");
+  if (const auto one = n.value<std::string>()) {
+    files.push_back(*one);
+  } else if (const toml::array* a = n.as_array()) {
+    for (const auto& e : *a) {
+      const auto f = e.value<std::string>();
+      if (!f)
+        throw InputError(file_.string(), "case.laws", "must be a file path or a list of them");
+      files.push_back(*f);
+    }
+  } else {
+    throw InputError(file_.string(), "case.laws", "must be a file path or a list of them");
+  }
+  static constexpr const char* kLawArrays[] = {"material", "bar_law", "membrane_law"};
+  for (const auto& name : files) {
+    std::filesystem::path f = name;
+    if (f.is_relative()) f = file_.parent_path() / f;
+    if (!std::filesystem::is_regular_file(f))
+      throw InputError(file_.string(), "case.laws", "no such file: " + f.string());
+    const toml::table laws = parse_case_file(f);
+    for (const auto& [key, v] : laws) {
+      const std::string k(key.str());
+      const bool law = std::any_of(std::begin(kLawArrays), std::end(kLawArrays),
+                                   [&](const char* a) { return k == a; });
+      const toml::array* given = v.as_array();
+      if (!law || !given || !given->is_array_of_tables())
+        throw InputError(f.string(), k,
+                         "a laws file holds [[material]], [[bar_law]] and [[membrane_law]] "
+                         "tables only (read by case.laws of " +
+                             file_.string() + ")");
+      toml::array* mine = root_[k].as_array();
+      for (std::size_t i = 0; i < given->size(); ++i) {
+        const toml::table& t = *given->get(i)->as_table();
+        const std::string at = k + "[" + std::to_string(i) + "].name";
+        const auto law_name = t["name"].value<std::string>();
+        if (!law_name)
+          throw InputError(f.string(), at, "missing (the name of the law it replaces)");
+        std::string names;
+        bool replaced = false;
+        for (std::size_t j = 0; mine && j < mine->size(); ++j) {
+          toml::table* m = mine->get(j)->as_table();
+          const auto mn = m ? (*m)["name"].value<std::string>() : std::nullopt;
+          if (!mn) continue;
+          if (*mn == *law_name) {
+            *m = t;
+            replaced = true;
+            break;
+          }
+          names += (names.empty() ? "" : ", ") + *mn;
+        }
+        if (!replaced)
+          throw InputError(f.string(), at,
+                           "the case " + file_.string() + " has no [[" + k + "]] named '" +
+                               *law_name +
+                               "' to replace (it has: " + (names.empty() ? "none" : names) + ")");
+      }
+    }
+  }
+}
+
 void CaseDocument::check_unknown_keys() const {
   std::vector<std::string> leaves;
   collect_leaves(root_, "", leaves);

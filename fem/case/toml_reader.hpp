@@ -31,6 +31,14 @@ class CaseDocument {
                                     const std::vector<std::string>& overrides, int depth);
   const std::filesystem::path& file() const { return file_; }
   const toml::table& root() const { return root_; }
+  /// `[case] laws = "laws.toml"` (or a list of files, relative to the case; [] for none): whole
+  /// [[material]], [[bar_law]] and [[membrane_law]] tables, such as a calibration stage hands on
+  /// (docs/case-file.md, "Calibrated laws"), that replace the case's tables of the same names,
+  /// in the order given. A table of a name the case lacks, a table without a name or another
+  /// section in the file is bad input naming the laws file and the key. Engine cases call it
+  /// after loading (a workflow hashes its stages' cases without it: their laws files are their
+  /// upstream stages' results).
+  void apply_laws_files();
   void mark_read(const std::string& path) { read_.insert(path); }
   /// Throws InputError for the first key in the file that was never read.
   void check_unknown_keys() const;

@@ -297,3 +297,55 @@ TEST(CaseReading, MassScalingKeysNameTheirRangeAndWhatTheyNeed) {
   EXPECT_EQ(ok.model.time.mass_scaling_max_ratio, 3.0);
   EXPECT_TRUE(ok.model.time.mass_scaling_erode_at_cap);
 }
+
+// `case.laws` (a calibration's laws.toml handed on by a workflow): each of its named [[material]],
+// [[bar_law]] and [[membrane_law]] tables replaces the case's table of that name whole, the other
+// tables stay; a law the case lacks, a table without a name or another section is bad input naming
+// the laws file and the key.
+TEST(CaseReading, LawsFileReplacesTheCasesLawsOfTheSameName) {
+  write_case("laws_ok", "[[material]]\nname = \"dry_tow\"\ntype = \"elastic\"\nE = 2.0e9\n");
+  const fs::path c =
+      write_case("laws_case",
+                 "[case]\nname = \"laws\"\nlaws = \"laws_ok.toml\"\n"
+                 "[[material]]\nname = \"other\"\ntype = \"elastic\"\nE = 1.0\n"
+                 "[[material]]\nname = \"dry_tow\"\ntype = \"elastic\"\nE = 1.0e9\nnu = 0.3\n");
+  auto doc = fem::CaseDocument::load(c, {});
+  doc.apply_laws_files();
+  const auto& m = *doc.root()["material"].as_array();
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_DOUBLE_EQ((*m.get(0)->as_table())["E"].value<double>().value(), 1.0);  // untouched
+  EXPECT_DOUBLE_EQ((*m.get(1)->as_table())["E"].value<double>().value(), 2.0e9);
+  EXPECT_FALSE((*m.get(1)->as_table())["nu"]) << "the table is replaced whole, not merged";
+
+  // None given: an empty list (what a workflow's input key replaces) changes nothing.
+  auto none = fem::CaseDocument::load(c, {"case.laws=[]"});
+  none.apply_laws_files();
+  EXPECT_DOUBLE_EQ(
+      (*(*none.root()["material"].as_array()).get(1)->as_table())["E"].value<double>().value(),
+      1.0e9);
+
+  const auto error_of = [&](const std::string& laws_text) -> std::pair<std::string, std::string> {
+    const fs::path f = write_case("laws_bad", laws_text);
+    auto d = fem::CaseDocument::load(c, {"case.laws='laws_bad.toml'"});
+    try {
+      d.apply_laws_files();
+    } catch (const InputError& e) {
+      return {e.file(), e.key()};
+    }
+    return {"", "(no error)"};
+  };
+  const std::string bad =
+      (fs::temp_directory_path() / "ncfsim_test_case_reading/laws_bad.toml").string();
+  EXPECT_EQ(error_of("[[material]]\nname = \"missing\"\nE = 1.0\n"),
+            std::make_pair(bad, std::string("material[0].name")));
+  EXPECT_EQ(error_of("[[bar_law]]\ntype = \"tabulated\"\n"),
+            std::make_pair(bad, std::string("bar_law[0].name")));
+  EXPECT_EQ(error_of("[time]\nend_time = 1.0\n"), std::make_pair(bad, std::string("time")));
+  auto nofile = fem::CaseDocument::load(c, {"case.laws='nowhere.toml'"});
+  try {
+    nofile.apply_laws_files();
+    ADD_FAILURE() << "a missing laws file must be bad input";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "case.laws");
+  }
+}

@@ -25,7 +25,8 @@ namespace {
 const fs::path kCase = kSource / "cases/hemisphere/drape.toml";
 
 // The CI-mesh chain through the workflow of the demo (cases/hemisphere/ci/workflow.toml): the
-// meso drape, the fishnet drape, the macro shell drape, the transfer of the dome and its crush,
+// tow's E11f calibrated to the fabric's bending length and handed to the meso drape (case.laws),
+// the meso drape, the fishnet drape, the macro shell drape, the transfer of the dome and its crush,
 // each in its sub-folder; a rerun with nothing changed skips every stage. On one rank: the suite
 // runs two tests at a time on the 2-core machines, and MPI ranks spin while they wait, so on 2
 // ranks beside another test it took as long (1282 s against 1278) and slowed the test beside it
@@ -46,7 +47,7 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   ASSERT_EQ(r.code, 0) << r.output;
   const auto ws = nlohmann::json::parse(slurp(wf / "summary.json"));
   EXPECT_EQ(ws["status"], "completed");
-  ASSERT_EQ(ws["stages"].size(), 5u);  // drape, fishnet, macro, transfer, crush
+  ASSERT_EQ(ws["stages"].size(), 6u);  // tow_bending, drape, fishnet, macro, transfer, crush
   for (const auto& st : ws["stages"]) EXPECT_EQ(st["status"], "completed") << st["name"];
   {  // The macro shell drape beside it (issue #19): the symmetric law's four quadrants agree.
     const auto ms = nlohmann::json::parse(slurp(wf / "macro" / "summary.json"));
@@ -57,6 +58,15 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
   const fs::path out = wf / "drape";
   const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
   EXPECT_EQ(s["status"], "completed");
+  {  // The drape's tow law is the calibrated one (the stage hand-off).
+    const auto tb = nlohmann::json::parse(slurp(wf / "tow_bending" / "summary.json"));
+    EXPECT_TRUE(tb["converged"].get<bool>());
+    const std::string laws = (wf / "tow_bending" / "laws.toml").string();
+    bool handed = false;
+    for (const auto& o : s["overrides"])
+      handed = handed || o.get<std::string>().find(laws) != std::string::npos;
+    EXPECT_TRUE(handed) << s["overrides"].dump();
+  }
   // Full depth: the punch centre starts 81 mm below the blankholder plane.
   EXPECT_GE(s["punch_displacement_m"].get<double>(), 0.081);
   EXPECT_LT(s["energy_balance_error_max"].get<double>(), 0.02);

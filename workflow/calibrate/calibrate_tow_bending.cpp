@@ -54,7 +54,7 @@ TowBendingResult calibrate_tow_bending(const TowBendingCalibration& cal) {
     const double E1 = s[probe_key + "_axial_modulus_Pa"].get<double>();
     runs.push_back({{"run", k}, {"E11f_Pa", E11f}, {"axial_modulus_Pa", E1}, {"bending_length_m", c},
                     {"beam_theory_bending_length_m", s[probe_key + "_beam_theory_bending_length_m"]}});
-    res = {E11f, c, k + 1, std::abs(c / cal.target_bending_length - 1) <= cal.tolerance};
+    res = {E11f, c, k + 1, std::abs(c / cal.target_bending_length - 1) <= cal.tolerance, mat_index};
     if (res.converged) break;
     // c ~ E1^(1/3): scale the axial modulus by the cube of the length ratio; the matrix phase
     // keeps its share (E1 = E11f + matrix part).

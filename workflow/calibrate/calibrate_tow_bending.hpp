@@ -24,6 +24,7 @@ struct TowBendingResult {
   double bending_length = 0;   // m, simulated with E11f
   int runs = 0;
   bool converged = false;
+  std::size_t material_index = 0;  // the bent part's [[material]] in the case
 };
 
 /// Needs a case with an [[output.bending_length]] probe on a part of type tow_biphase. Runs go to

@@ -65,6 +65,24 @@ SummaryMean read_mean(const TableReader& t) {
   return sm;
 }
 
+SummaryTarget read_target(const TableReader& t) {
+  SummaryTarget st;
+  st.quantity = t.string("quantity");
+  if (t.has("target") == t.has("target_quantity"))
+    t.fail("target", "give one of target (a number) and target_quantity (a summary.json key)");
+  if (t.has("target"))
+    st.target = t.number("target", Range{});
+  else
+    st.target_quantity = t.string("target_quantity");
+  if (t.has("tolerance") && t.has("relative_tolerance"))
+    t.fail("tolerance", "give at most one of tolerance (absolute) and relative_tolerance");
+  if (t.has("tolerance")) st.tolerance = t.number("tolerance", Range::non_negative());
+  if (t.has("relative_tolerance"))
+    st.relative_tolerance = t.number("relative_tolerance", Range::closed(0, 10));
+  st.source = t.string("source", "");
+  return st;
+}
+
 SummarySamples read_sample(const TableReader& t) {
   SummarySamples ss;
   ss.x = t.string("x");
@@ -105,6 +123,7 @@ void read_output(const CaseReadContext& ctx, EngineCase& ec) {
   ec.shear_probes = drape::read_shear_probes(ctx, *o);
   ec.ring_probes = drape::read_ring_shear_probes(ctx, *o);
   for (const auto& t : o->tables("mean")) ec.means.push_back(read_mean(t));
+  for (const auto& t : o->tables("target")) ec.targets.push_back(read_target(t));
   ec.bending = drape::read_bending_probes(ctx, *o);
   for (const auto& t : o->tables("sample")) ec.samples.push_back(read_sample(t));
 }
@@ -203,6 +222,7 @@ fem::CaseTypeRegistry engine_case_types() {
 EngineCase load_engine_case(const std::filesystem::path& file,
                             const std::vector<std::string>& overrides) {
   fem::CaseDocument doc = fem::CaseDocument::load(file, overrides);
+  doc.apply_laws_files();  // a calibration's laws, handed on by a workflow
   const fem::CaseTypeRegistry types = engine_case_types();
   EngineCase ec;
   ec.file = file;

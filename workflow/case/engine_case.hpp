@@ -3,6 +3,7 @@
 // materials, bar laws, parts, constraints, loads, rigid tools, time controls, output, figures. The
 // keys are documented in docs/case-file.md; every value is range-checked before any run, once, by
 // the module that owns its section (fem/case, drape/case; docs/architecture.md).
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -62,6 +63,18 @@ struct SummaryMean {
   double from_time = 0, to_time = 0, scale = 1;
   std::string
       per_column;  // if set: scale * increment of column / increment of per_column over the window
+};
+
+/// `[[output.target]]`: a number of the run's summary.json against what it should be (a paper's
+/// formula written by a measure, a datum of the case): summary.json `targets` and `targets_met`,
+/// a warning for one missed, the workflow report's table of virtual tests against their targets.
+struct SummaryTarget {
+  std::string quantity;             // a summary.json number of this run
+  double target = std::nan("");     // the target value, or ...
+  std::string target_quantity;      // ... another summary.json number of the run (e.g. Eq. 2's)
+  double tolerance = std::nan("");  // absolute, in the quantity's unit (NaN: none)
+  double relative_tolerance = std::nan("");  // of the target (NaN: none); neither: shown only
+  std::string source;                        // where the target comes from, for the report
 };
 
 struct OutputSettings {
@@ -135,6 +148,7 @@ struct EngineCase {
   std::vector<SummarySamples> samples;
   std::vector<BendingLengthProbe> bending;
   std::vector<SummaryMean> means;
+  std::vector<SummaryTarget> targets;
   std::vector<double> frame_fabric_length;  // per picture frame: side of the fabric for normalising
   impact::CrushSpec crush;                  // [crush]: the punch's measures (kind crush)
 };

@@ -164,6 +164,7 @@ struct Run {
   Clock::time_point wall0;
   json summary;
   std::string status = "completed", failure;
+  std::vector<std::string> target_warnings;  // [[output.target]] entries missed (add_targets)
   // Largest energy-balance error per decade of the energy in play so far (scale_max): the
   // summary's maximum skips the decades far below the run's largest energy, where the residual
   // is round-off on next to nothing (a model at rest before the tool arrives).
@@ -257,6 +258,7 @@ void fill_summary(Run& r, const fem::ExplicitSolver& s, const MeasureList& measu
   r.summary["kinetic_to_internal_exceeded"] = r.ke_ie_exceeded;
   for (const auto& m : measures) m->add_summary(s, r.summary);
   add_history_summary(r.ec, history, r.summary);
+  r.target_warnings = add_targets(r.ec, r.summary);
   if (!r.failure.empty()) r.summary["error"] = r.failure;
 }
 
@@ -846,6 +848,7 @@ int finish_run(Run& r, fem::ExplicitSolver& solver, MeasureList& measures, RunHi
     exit_code = kOtherError;  // docs/cli.md: results valid, the run did not reach its end
   fill_summary(r, solver, measures, history, frames);
   r.write_summary();
+  for (const auto& line : r.target_warnings) r.log->warn("{}", line);
   for (const auto& m : measures)
     for (const auto& f : m->write_files(solver, r.dir))
       r.log->info("wrote {}", (r.dir / f).string());

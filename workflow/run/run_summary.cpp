@@ -1,5 +1,7 @@
 #include "workflow/run/run_summary.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
 
@@ -211,6 +213,56 @@ void add_samples(const SummarySamples& ss, const RunHistory& h, json& summary) {
 void add_history_summary(const EngineCase& ec, const RunHistory& history, json& summary) {
   for (const auto& sm : ec.means) add_mean(sm, history, summary);
   for (const auto& ss : ec.samples) add_samples(ss, history, summary);
+}
+
+std::vector<std::string> add_targets(const EngineCase& ec, json& summary) {
+  std::vector<std::string> lines;
+  if (ec.targets.empty()) return lines;
+  const auto value_of = [&](const std::string& key) {
+    return summary.contains(key) && summary[key].is_number() ? summary[key].get<double>()
+                                                             : std::nan("");
+  };
+  json rows = json::array();
+  bool all_met = true;
+  for (const auto& t : ec.targets) {
+    const double v = value_of(t.quantity);
+    const double target = t.target_quantity.empty() ? t.target : value_of(t.target_quantity);
+    const double allowed = !std::isnan(t.tolerance) ? t.tolerance
+                           : !std::isnan(t.relative_tolerance)
+                               ? t.relative_tolerance * std::abs(target)
+                               : std::nan("");
+    json row{{"quantity", t.quantity},
+             {"value", fem::json_number(v)},
+             {"target", fem::json_number(target)},
+             {"source", t.source}};
+    if (!t.target_quantity.empty()) row["target_quantity"] = t.target_quantity;
+    if (!std::isnan(t.tolerance)) row["tolerance"] = t.tolerance;
+    if (!std::isnan(t.relative_tolerance)) row["relative_tolerance"] = t.relative_tolerance;
+    const std::string what =
+        t.target_quantity.empty() ? fmt::format("{:.4g}", target) : t.target_quantity;
+    if (std::isnan(v) || std::isnan(target)) {
+      row["met"] = nullptr;
+      all_met = all_met && std::isnan(allowed);
+      lines.push_back(fmt::format("target {}: not measured ({} is not a number of this run)",
+                                  t.quantity, std::isnan(v) ? t.quantity : t.target_quantity));
+    } else if (std::isnan(allowed)) {
+      row["met"] = nullptr;  // shown beside its target, not checked
+    } else {
+      const bool met = std::abs(v - target) <= allowed;
+      row["met"] = met;
+      all_met = all_met && met;
+      if (!met)
+        lines.push_back(
+            fmt::format("target {}: {:.4g} is {:.3g} from its target {} = {:.4g} "
+                        "(allowed {:.3g}; {})",
+                        t.quantity, v, std::abs(v - target), what, target, allowed,
+                        t.source.empty() ? "[[output.target]]" : t.source));
+    }
+    rows.push_back(row);
+  }
+  summary["targets"] = rows;
+  summary["targets_met"] = all_met;
+  return lines;
 }
 
 std::vector<std::pair<std::string, double>> cycle_phases(const fem::ExplicitSolver& s) {

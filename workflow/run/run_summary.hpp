@@ -42,4 +42,11 @@ void add_state_summary(const fem::ExplicitSolver& s, double energy_balance_error
 /// they cannot be measured).
 void add_history_summary(const EngineCase& ec, const RunHistory& history, nlohmann::json& summary);
 
+/// The case's [[output.target]] entries against the summary's numbers (so after every other
+/// entry): summary `targets` (quantity, value, target, target_quantity, tolerance,
+/// relative_tolerance, source, met: true / false / null where no tolerance is given or a number
+/// is missing) and `targets_met` (false where any checked target is missed). Returns one line
+/// per target missed or not measured, for the log's warnings.
+std::vector<std::string> add_targets(const EngineCase& ec, nlohmann::json& summary);
+
 }  // namespace ncfsim::workflow

@@ -12,6 +12,7 @@
 #include "fem/memory_estimate.hpp"
 #include "fem/petsc_vector.hpp"
 #include "fem/solver.hpp"
+#include "workflow/calibrate/calibration_stage.hpp"
 #include "workflow/run/run_summary.hpp"
 #include "workflow/stages/kinematic_drape_stage.hpp"
 #include "workflow/stages/transfer_stage.hpp"
@@ -143,6 +144,17 @@ const std::vector<Stage>& stages() {
        {},
        "",
        ""},
+      {fem::stage_kind::kCalibration,
+       "a law from virtual tests (macro membrane law from the picture frames, tow E11f from the "
+       "cantilever, stitch law from bias-extension data), handed on as laws.toml",
+       &run_calibration_stage,
+       &check_calibration_stage,
+       false,
+       false,
+       {},
+       "",
+       "",
+       kLawsFile},
       {fem::stage_kind::kWorkflow,
        "stages (drape, fishnet, transfer, crush, ...) from case files of their own into one "
        "folder, unchanged stages skipped, one report",

@@ -47,6 +47,8 @@ struct Stage {
   /// the stage's name ("": the meso column shear_deg, or macro_shear_deg where a macro drape
   /// wrote it).
   std::string ring_column, ring_label;
+  /// The file of its folder a downstream stage's input key receives (a workflow's `inputs`).
+  std::string handoff = "results.h5";
 };
 
 /// The registered stages, in the order they are listed in messages.

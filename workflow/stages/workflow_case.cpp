@@ -91,6 +91,9 @@ WorkflowCase load_workflow_case(const std::filesystem::path& file,
         s.inputs.emplace_back(key, in->string(key));
       }
     }
+    // The stage's own changes to its case (a virtual test on the CI mesh), as --set items
+    // routed to it, before the command line's.
+    if (t.has("set")) s.overrides = t.strings("set");
     for (const auto& [key, up] : s.inputs) s.after.push_back(up);
     if (t.has("after"))
       for (const auto& up : t.strings("after")) s.after.push_back(up);

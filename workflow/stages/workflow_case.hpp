@@ -8,6 +8,7 @@
 //   case = "transfer_dome.toml"                 # relative to the workflow file
 //   inputs = { "source.results" = "drape" }     # this key of its case <- drape/results.h5
 //   after = ["fishnet"]                         # optional: order without a file handed over
+//   set = ["mesh.resolution=coarse"]            # optional: changes to its case, as --set
 //
 // Overrides (--set) whose first key names a stage reach that stage only
 // (`drape.mesh.resolution=coarse`); any other reaches every stage whose case has the first key's
@@ -25,7 +26,8 @@ struct WorkflowStageSpec {
   /// Case key of this stage -> upstream stage whose results.h5 it reads.
   std::vector<std::pair<std::string, std::string>> inputs;
   std::vector<std::string> after;      // upstream stages (inputs' stages and `after`), unique
-  std::vector<std::string> overrides;  // --set items routed to this stage (key without the stage)
+  std::vector<std::string> overrides;  // `set`, then --set items routed to this stage (key
+                                       // without the stage)
   int ranks = 0;  // `ranks`: MPI ranks of an engine/crush stage (0: the workflow's --np)
 };
 

@@ -101,7 +101,7 @@ bool unchanged(const StagePlan& p) {
 
 std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out, int ranks) {
   std::vector<StagePlan> plans;
-  std::map<std::string, std::string> hashes;
+  std::map<std::string, std::string> hashes, handoff;  // per stage name
   for (const auto& s : wc.stages) {
     StagePlan p;
     p.spec = s;
@@ -109,7 +109,7 @@ std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out, int ran
     p.overrides = s.overrides;
     for (const auto& [key, up] : s.inputs)
       p.overrides.push_back(key + "=" +
-                            json(fs::absolute(out / up / "results.h5").string()).dump());
+                            json(fs::absolute(out / up / handoff.at(up)).string()).dump());
     p.kind = case_kind(s.case_file, p.overrides);
     // A known kind, or bad input naming the stage's file.
     const Stage& stage = find_stage(p.kind, s.case_file);
@@ -125,6 +125,7 @@ std::vector<StagePlan> plan(const WorkflowCase& wc, const fs::path& out, int ran
     p.ranks = s.ranks > 0 ? s.ranks : stage.time_loop ? ranks : 1;
     hash_stage(p, hashes);
     hashes[s.name] = p.hash;
+    handoff[s.name] = stage.handoff;
     plans.push_back(std::move(p));
   }
   return plans;
@@ -575,6 +576,73 @@ void key_results_section(std::ostream& h, const json& stages,
   h << "</table>\n";
 }
 
+// Every stage's `targets` (the virtual tests' [[output.target]] entries, a calibration's target):
+// what was measured against what it should be, and where the target comes from; then what each
+// calibration stage calibrated from which test (a characterisation's report, issue #43).
+void targets_section(std::ostream& h, const json& stages, const std::map<std::string, json>& sums) {
+  std::ostringstream rows;
+  std::size_t n = 0, missed = 0;
+  const auto num = [](const json& v) {
+    return v.is_number() ? fmt::format("{:.4g}", v.get<double>()) : std::string("-");
+  };
+  for (const auto& e : stages) {
+    const std::string nm = e["name"].get<std::string>();
+    const json& ss = sums.at(nm);
+    if (!ss.is_object() || !ss.contains("targets")) continue;
+    for (const auto& t : ss["targets"]) {
+      const json& met = t.contains("met") ? t["met"] : json();
+      std::string tol = "shown, not checked";
+      if (t.contains("tolerance")) tol = "&plusmn; " + num(t["tolerance"]);
+      if (t.contains("relative_tolerance"))
+        tol = fmt::format("&plusmn; {:.3g} %", 100 * t["relative_tolerance"].get<double>());
+      std::string verdict = "-";
+      if (met.is_boolean()) {
+        verdict = met.get<bool>() ? "<span class=\"ok\">met</span>"
+                                  : "<span class=\"bad\">&#9888; missed</span>";
+        missed += met.get<bool>() ? 0 : 1;
+      }
+      std::string target = num(t.value("target", json()));
+      if (t.contains("target_quantity"))
+        target += " (" + escape(t["target_quantity"].get<std::string>()) + ")";
+      rows << "<tr><td>" << escape(nm) << "</td><td>" << escape(t.value("quantity", ""))
+           << "</td><td>" << num(t.value("value", json())) << "</td><td>" << target << "</td><td>"
+           << tol << "</td><td>" << verdict << "</td><td>" << escape(t.value("source", ""))
+           << "</td></tr>\n";
+      ++n;
+    }
+  }
+  std::ostringstream cal;
+  for (const auto& e : stages) {
+    const std::string nm = e["name"].get<std::string>();
+    const json& ss = sums.at(nm);
+    if (!ss.is_object() || !ss.contains("calibrated_from")) continue;
+    std::string what;
+    if (ss.contains("membrane_law"))
+      what = "[[membrane_law]] " + ss["membrane_law"].get<std::string>();
+    if (ss.contains("E11f_Pa")) what = fmt::format("E11f = {:.4g} Pa", ss["E11f_Pa"].get<double>());
+    if (ss.contains("bar_law")) what = "[[bar_law]] " + ss["bar_law"].get<std::string>();
+    std::string from;
+    for (const auto& [k, v] : ss["calibrated_from"].items())
+      from += (from.empty() ? "" : "; ") + k + ": " + v.get<std::string>();
+    cal << "<tr><td>" << escape(nm) << "</td><td>" << escape(ss.value("method", "")) << "</td><td>"
+        << escape(what) << "</td><td>" << escape(from) << "</td><td>"
+        << (ss.contains("laws_file")
+                ? "<a href=\"" + escape(nm) + "/" + escape(ss["laws_file"].get<std::string>()) +
+                      "\">" + escape(ss["laws_file"].get<std::string>()) + "</a>"
+                : std::string("none (see its summary)"))
+        << "</td></tr>\n";
+  }
+  if (n > 0)
+    h << "<h2>Against their targets (" << n << ", " << missed << " missed)</h2>\n"
+      << "<table><tr><th>stage</th><th>quantity</th><th>value</th><th>target</th>"
+         "<th>tolerance</th><th>verdict</th><th>target from</th></tr>\n"
+      << rows.str() << "</table>\n";
+  if (!cal.str().empty())
+    h << "<h2>Calibrated laws</h2>\n<table><tr><th>stage</th><th>method</th><th>law</th>"
+         "<th>from</th><th>file</th></tr>\n"
+      << cal.str() << "</table>\n";
+}
+
 // A history plot whose every curve is zero (a tool that never touched, a fixed tool's
 // displacement) says nothing: its name, to be listed instead of drawn.
 std::vector<std::string> zero_plots(const fs::path& stage_dir) {
@@ -692,6 +760,7 @@ void write_workflow_report(const fs::path& dir) {
   const json& stages = s["stages"];
   headline_section(h, dir, stages);
   drapes_section(h, dir, stages, sums);
+  targets_section(h, stages, sums);
   key_results_section(h, stages, sums);
   process_section(h, dir, stages, sums);
   figures_section(h, dir, stages);
