@@ -1,4 +1,5 @@
 // [[tool]] (rigid tools) and [[contact]] (deformable contacts).
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -93,6 +94,29 @@ double covered_area(const TableReader& t, const RigidTool& tool, const Mesh& mes
   return area;
 }
 
+// `seat_clearance`: a plane placed along its normal this far from the nearest of its contact nodes
+// (a support plate under a part whose formed shape the case cannot know: a draped dome handed on
+// by a transfer). The point then fixes only the plane's in-plane position.
+void seat_plane(const TableReader& t, RigidTool& tool, const Mesh& mesh) {
+  if (!t.has("seat_clearance")) return;
+  const double clearance = t.number("seat_clearance", Range::non_negative());
+  if (tool.surface.shape != ToolShape::Plane && tool.surface.shape != ToolShape::PlaneWithHole)
+    t.fail("seat_clearance",
+           "only a plane or plane_with_hole tool is seated (it moves along its normal); place a "
+           "curved tool by its point");
+  double nearest = std::numeric_limits<double>::infinity();
+  const V3& n = tool.surface.axis;
+  for (auto node : tool.contact_nodes) {
+    const auto p = mesh.node(static_cast<std::size_t>(node));
+    const V3 r{p[0] - tool.surface.point.x, p[1] - tool.surface.point.y,
+               p[2] - tool.surface.point.z};
+    nearest = std::min(nearest, r.x * n.x + r.y * n.y + r.z * n.z);
+  }
+  const double shift = nearest - tool.thickness - clearance;
+  tool.surface.point = V3{tool.surface.point.x + shift * n.x, tool.surface.point.y + shift * n.y,
+                          tool.surface.point.z + shift * n.z};
+}
+
 // A tool must start clear of its contact nodes: a node inside it would be thrown out by the
 // penalty spring at the first cycle (k = scale m / dt^2 times the depth).
 void check_starts_clear(const TableReader& t, const RigidTool& tool, const Mesh& mesh) {
@@ -164,6 +188,7 @@ void read_tool(CaseReadContext& ctx, const TableReader& t) {
     t.fail("contact_nodes", "missing, and the model has no solid or shell element to touch");
   tool.thickness = t.number("thickness", half_shell_thickness(ctx.model, tool.contact_nodes),
                             Range::non_negative());
+  seat_plane(t, tool, ctx.model.mesh);
   check_starts_clear(t, tool, ctx.model.mesh);
   if (tool.motion.kind == ToolMotion::Kind::Force && t.has("pressure")) {
     if (tool.surface.shape != ToolShape::Plane && tool.surface.shape != ToolShape::PlaneWithHole)
