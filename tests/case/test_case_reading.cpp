@@ -349,3 +349,35 @@ TEST(CaseReading, LawsFileReplacesTheCasesLawsOfTheSameName) {
     EXPECT_EQ(e.key(), "case.laws");
   }
 }
+
+// `seat_clearance`: a plane tool is moved along its normal until the nearest of its contact nodes
+// is that far (plus its thickness) on the side its axis points to, wherever its point put it
+// (inside the part or far from it); a curved tool is refused.
+TEST(CaseReading, SeatedPlaneSitsItsClearanceFromTheNearestNode) {
+  const auto with_tool = [](const std::string& tool) {
+    std::string c = contact_case("friction = 0.1\n");
+    return c + tool;
+  };
+  for (const double z0 : {0.005, -0.3}) {  // inside the lower block; far below it
+    const fs::path f = write_case(
+        "seated",
+        with_tool("[[tool]]\nname = \"support\"\nshape = \"plane\"\npoint = [0.002, 0.0, " +
+                  std::to_string(z0) +
+                  "]\naxis = [0.0, 0.0, 1.0]\nseat_clearance = 2.0e-4\nthickness = 1.0e-4\n"));
+    const auto ec = workflow::load_engine_case(f, {});
+    ASSERT_EQ(ec.model.tools.size(), 1u);
+    const auto& s = ec.model.tools[0].surface;
+    EXPECT_NEAR(s.point.z, 0.0 - 1.0e-4 - 2.0e-4, 1e-12) << z0;  // the lowest nodes lie at z = 0
+    EXPECT_DOUBLE_EQ(s.point.x, 0.002);
+  }
+  const fs::path bad = write_case(
+      "seated_sphere",
+      with_tool("[[tool]]\nname = \"ball\"\nshape = \"sphere\"\npoint = [0.0, 0.0, 0.1]\n"
+                "radius = 0.01\nseat_clearance = 1.0e-4\n"));
+  try {
+    (void)workflow::load_engine_case(bad, {});
+    ADD_FAILURE() << "a seated sphere must be refused";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "tool[0].seat_clearance");
+  }
+}
