@@ -322,6 +322,7 @@ void CaseDocument::apply_laws_files() {
           if (*mn == *law_name) {
             *m = t;
             replaced = true;
+            laws_replaced_.push_back("[[" + k + "]] '" + *law_name + "' from " + f.string());
             break;
           }
           names += (names.empty() ? "" : ", ") + *mn;

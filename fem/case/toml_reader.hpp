@@ -39,6 +39,8 @@ class CaseDocument {
   /// after loading (a workflow hashes its stages' cases without it: their laws files are their
   /// upstream stages' results).
   void apply_laws_files();
+  /// What apply_laws_files replaced: "[[material]] 'dry_tow' from <file>", in order.
+  const std::vector<std::string>& laws_replaced() const { return laws_replaced_; }
   void mark_read(const std::string& path) { read_.insert(path); }
   /// Throws InputError for the first key in the file that was never read.
   void check_unknown_keys() const;
@@ -47,6 +49,7 @@ class CaseDocument {
   std::filesystem::path file_;
   toml::table root_;
   std::set<std::string> read_;
+  std::vector<std::string> laws_replaced_;
 };
 
 /// A view of one table of the document at `path` ("" = root, "mesh.block[2]").

@@ -132,8 +132,11 @@ TEST(CliRegressionCharacterisation, CiChainMeetsItsTargetsAndHandsOnItsLaws) {
                "case.laws=" + json((out / "tow_bending/laws.toml").string()).dump(), "--set",
                "output.figures=false", "--set", "output.report=false"});
   ASSERT_EQ(rl.code, 0) << rl.output;
-  EXPECT_NEAR(summary_of(with_laws)["tow_bending_length_m"].get<double>(),
-              tb["bending_length_m"].get<double>(), 1e-9);
+  const json wl = summary_of(with_laws);
+  EXPECT_NEAR(wl["tow_bending_length_m"].get<double>(), tb["bending_length_m"].get<double>(), 1e-9);
+  ASSERT_EQ(wl["laws_replaced"].size(), 1u);
+  EXPECT_EQ(wl["laws_replaced"][0].get<std::string>().rfind("[[material]] 'dry_tow' from ", 0), 0u)
+      << wl["laws_replaced"].dump();
 
   // The macro law: one curve per sign from the frames, the pillars make the positive stiffer.
   const json ml = summary_of(out / "macro_law");

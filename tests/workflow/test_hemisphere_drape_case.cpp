@@ -66,6 +66,9 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
     for (const auto& o : s["overrides"])
       handed = handed || o.get<std::string>().find(laws) != std::string::npos;
     EXPECT_TRUE(handed) << s["overrides"].dump();
+    ASSERT_EQ(s["laws_replaced"].size(), 1u);
+    EXPECT_NE(s["laws_replaced"][0].get<std::string>().find("'dry_tow' from " + laws), std::string::npos)
+        << s["laws_replaced"].dump();
   }
   // Full depth: the punch centre starts 81 mm below the blankholder plane.
   EXPECT_GE(s["punch_displacement_m"].get<double>(), 0.081);

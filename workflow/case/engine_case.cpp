@@ -226,6 +226,7 @@ EngineCase load_engine_case(const std::filesystem::path& file,
   const fem::CaseTypeRegistry types = engine_case_types();
   EngineCase ec;
   ec.file = file;
+  ec.laws_replaced = doc.laws_replaced();
   CaseReadContext ctx(doc, ec.model, types);
   read_case_header(ctx.root, ec);
   // The mesh: [mesh] blocks and fabrics, or [model], the impregnated part a transfer wrote.

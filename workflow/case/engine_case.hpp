@@ -135,6 +135,7 @@ struct EngineCase {
   std::string kind;  // "engine"
   std::string description;
   std::string resolution;  // coarse | default | fine
+  std::vector<std::string> laws_replaced;  // case.laws: "[[material]] 'dry_tow' from <file>"
   fem::Model model;
   std::vector<DisplacementProbe> probes;
   std::vector<ReactionProbe> reactions;

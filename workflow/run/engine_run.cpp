@@ -195,6 +195,8 @@ struct Run {
   Clock::time_point last_checkpoint;   // wall time of the last checkpoint (or the start)
   std::int64_t checkpoint_cycle = -1;  // cycle of the last checkpoint written or loaded
   double wall_seconds() const { return wall_before + seconds_since(wall0); }
+  // (wall s, simulated s) at each progress line: the ETA's recent rate (log_progress).
+  mutable std::vector<std::pair<double, double>> progress;
   // This segment's time loop: wall and CPU seconds of the main thread and its cycles. The phase
   // timers are wall time; on a shared machine a run is off the CPU part of it, which the
   // benchmarks (thread CPU time) do not count: loop_cpu / loop_wall scales them to CPU time.
@@ -218,6 +220,7 @@ void log_start(const Run& r) {
               r.ec.resolution);
   if (!r.ec.description.empty()) r.log->info("  {}", r.ec.description);
   for (const auto& ov : r.options.overrides) r.log->info("  --set {}", ov);
+  for (const auto& law : r.ec.laws_replaced) r.log->info("  law {} (case.laws)", law);
   if (fem::PetscSession::size() > 1)
     r.log->info("on {} MPI ranks (domain decomposition, docs/parallel.md)",
                 fem::PetscSession::size());
@@ -504,14 +507,28 @@ bool output_due(double t, const Run::LoopState& loop) {
   return t >= loop.next_history || t >= loop.next_frame;
 }
 
+// Wall seconds to the end time at the rate of the last quarter of the wall time so far (at least
+// the last progress interval): a forming cycle costs more as the contact grows (the paper model's
+// 36 ms at the start, 54 ms at full depth), so the rate since the start under-read the time left.
+double eta_seconds(const Run& r, double t, double wall, double end_time) {
+  auto& p = r.progress;
+  p.emplace_back(wall, t);
+  std::size_t k = p.size() - 1;
+  while (k > 0 && p[k].first > 0.75 * wall) --k;
+  const double dw = wall - p[k].first, dt = t - p[k].second;
+  if (!(dt > 0 && dw > 0)) return t > 0 ? wall * (end_time - t) / t : -1;
+  return (end_time - t) * dw / dt;
+}
+
 void log_progress(const Run& r, const fem::ExplicitSolver& s, double err) {
   const auto& tc = s.model().time;
   const double t = s.time(), wall = r.wall_seconds(), frac = t / tc.end_time;
+  const double eta = eta_seconds(r, t, wall, tc.end_time);
   r.log->info(
       "t = {:.4e} / {:.4e} s ({:4.1f} %) | cycle {} | dt {:.3e} s | wall {} | ETA {} | energy "
       "balance {:.3f} %",
       t, tc.end_time, 100 * frac, s.cycle(), s.time_step(), hms(wall),
-      frac > 0 ? hms(wall * (1 - frac) / frac) : "--:--", 100 * err);
+      eta >= 0 ? hms(eta) : "--:--", 100 * err);
 }
 
 // The time loop to the end time (or the cycle limit, or an interrupt); returns the exit code.

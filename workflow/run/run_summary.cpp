@@ -30,6 +30,7 @@ json summary_header(const EngineCase& ec, const RunOptions& options) {
   summary["case_file"] = ec.file.string();
   summary["overrides"] = options.overrides;
   summary["resolution"] = ec.resolution;
+  if (!ec.laws_replaced.empty()) summary["laws_replaced"] = ec.laws_replaced;
   summary["status"] = "starting";
   return summary;
 }
