@@ -309,6 +309,23 @@ TEST(Cli, CalibrateStitchRoundTrip) {
   }
   EXPECT_GE(checked, 8);
   EXPECT_TRUE(fs::exists(dir / "out/stitch_law.toml"));
+  // The same as a stage of kind calibration (what a characterisation workflow runs): the same law,
+  // handed on as laws.toml (a [[bar_law]] that a case's case.laws takes).
+  std::ofstream(dir / "stitch.toml")
+      << "[case]\nname = \"stitch_Lambda\"\nkind = \"calibration\"\n[calibration]\nmethod = "
+         "\"stitch\"\n"
+         "data = \"bias.csv\"\nextension_column = \"extension_mm\"\nextension_scale = 1e-3\n"
+         "shear = \"negative\"\nlaw_name = \"stitch_Lambda\"\n";
+  const Result st =
+      run_cli({"-q", "run", (dir / "stitch.toml").string(), "-o", (dir / "stage").string()});
+  ASSERT_EQ(st.code, 0) << st.output;
+  EXPECT_EQ(slurp(dir / "stage/stitch_law.csv"), slurp(dir / "out/stitch_law.csv"));
+  const std::string laws = slurp(dir / "stage/laws.toml");
+  EXPECT_NE(laws.find("[[bar_law]]\nname = \"stitch_Lambda\""), std::string::npos) << laws;
+  const auto ss = nlohmann::json::parse(slurp(dir / "stage/summary.json"));
+  EXPECT_EQ(ss["stage"], "calibration");
+  EXPECT_EQ(ss["bar_law"], "stitch_Lambda");
+  EXPECT_EQ(ss["laws_file"], "laws.toml");
   const Result bad = run_cli({"calibrate", "stitch", (dir / "bias.csv").string()});
   EXPECT_EQ(bad.code, 2) << "a missing column is bad input: " << bad.output;
   EXPECT_NE(bad.output.find("extension_m"), std::string::npos) << bad.output;

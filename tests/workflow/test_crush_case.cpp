@@ -56,9 +56,9 @@ struct Fixture {
         // (crush.toml's): the elements past the snap-back limit get the smallest energy free of
         // it (issue #42)
         "--set", "model.damage.crack_band=\"raise\"",
-        // the punch 0.05 mm over the blanket's centre, the plate 0.01 mm under it
+        // the punch 0.05 mm over the blanket's centre, the plate seated 0.01 mm under it
         "--set", "tool[0].point=[0.03,0.03,0.02551]", "--set", "tool[0].ramp_time=1e-6", "--set",
-        "tool[1].point=[0.0,0.0,-1e-5]", "--set", "time.end_time=1.5e-4", "--set",
+        "tool[1].seat_clearance=1e-5", "--set", "time.end_time=1.5e-4", "--set",
         "time.quasi_static_from=8e-5", "--set", "time.history_interval=2.5e-6", "--set",
         "time.frame_interval=5e-5", "--set", "output.figures=false", "--set",
         "output.report=false"};

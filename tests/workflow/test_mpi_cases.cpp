@@ -235,11 +235,18 @@ const std::vector<Refused>& refused() {
 const std::vector<Covered>& covered() {
   // The paper-density drape takes hours; its CI size is cases/hemisphere/ci/drape.toml.
   // The meso coupons held flat are their cases (the same included coupon) with two z holds.
-  // The second fabric's CI hemisphere is that case with another fabric (the same kernels,
-  // contacts and tools).
+  // The second fabric's CI hemisphere and virtual tests are the +-45 cases with another fabric
+  // (the same kernels, contacts, tools and probes).
   static const std::vector<Covered> c = {
       {"hemisphere/drape.toml", "hemisphere/ci/drape.toml"},
       {"fabrics/biax_0_90_chain/hemisphere_ci.toml", "hemisphere/ci/drape.toml"},
+      {"fabrics/biax_0_90_chain/bias_extension.toml", "drape/bias_extension_positive.toml"},
+      {"fabrics/biax_0_90_chain/picture_frame.toml", "drape/picture_frame_positive.toml"},
+      {"fabrics/biax_0_90_chain/cantilever_bending.toml", "drape/cantilever_bending.toml"},
+      {"fabrics/biax_0_90_chain/sled_aluminium.toml", "drape/friction_sled_aluminium.toml"},
+      {"fabrics/biax_0_90_chain/sled_tow_tow.toml", "drape/friction_sled_tow_tow_0_0.toml"},
+      {"fabrics/biax_0_90_chain/sled_tow_tow_crossing.toml",
+       "drape/friction_sled_tow_tow_0_90.toml"},
       {"drape/macro/stitched/meso_bias_extension_positive_flat.toml",
        "drape/bias_extension_positive.toml"},
       {"drape/macro/stitched/meso_bias_extension_negative_flat.toml",

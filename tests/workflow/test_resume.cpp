@@ -272,7 +272,7 @@ figures = false
                                   "--set",
                                   "tool[0].ramp_time=1e-6",
                                   "--set",
-                                  "tool[1].point=[0.0,0.0,-1e-5]",
+                                  "tool[1].seat_clearance=1e-5",
                                   "--set",
                                   "time.end_time=1.5e-4",
                                   "--set",

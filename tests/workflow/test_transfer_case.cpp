@@ -179,7 +179,7 @@ TEST(CliTransfer, KeptStitchesBecomeBarsBetweenTowNodes) {
                           "--set", "model.damage.fracture_energy.transverse_shear=1600.0",
                           "--set", "tool[0].point=[0.03,0.03,0.02551]",
                           "--set", "tool[0].ramp_time=1e-6",
-                          "--set", "tool[1].point=[0.0,0.0,-1e-5]",
+                          "--set", "tool[1].seat_clearance=1e-5",
                           "--set", "time.end_time=1e-4",
                           "--set", "time.quasi_static_from=5e-5",
                           "--set", "output.figures=false",

@@ -177,7 +177,8 @@ CalibrationCase load_calibration_case(const fs::path& file,
   cc.name = header.name;
   cc.description = header.description;
   mark_included_sections(root);
-  const TableReader t = root.required_table("calibration");
+  const TableReader t =
+      root.required_table("calibration");  // the [calibration] table: not a stage kind
   if (!t.has("method")) t.fail("method", "missing (required): macro, tow_bending or stitch");
   cc.method = t.choice("method", {"macro", "tow_bending", "stitch"}, "macro");
   if (cc.method == "macro") read_macro(t, cc, runs_must_exist);
