@@ -220,65 +220,78 @@ int run_calibration_stage(const StageCall& call) {
   json targets = json::array();
   int code = kSuccess;
   const fs::path laws = dir / kLawsFile;
-  if (cc.method == "macro") {
-    MacroCalibrationOptions o = cc.macro;
-    o.output = laws;
-    o.curves_csv = dir / "frame_curves.csv";
-    const MacroCalibration r = calibrate_macro(o);
-    for (const auto& n : r.notes) log->info("{}", n);
-    s["membrane_law"] = o.name;
-    s["curve_points_positive"] = r.positive.curve.angle_deg.size();
-    s["curve_points_negative"] = o.symmetric ? 0 : r.negative.curve.angle_deg.size();
-    s["symmetric"] = o.symmetric;
-    s["stitch_bars"] = o.stitch_bars;
-    // The bias coupons against the force the law gives an ideal trellis: shown, not a target
-    // (the meso coupon slips between its tows, the trellis does not).
-    for (const auto& [sign, rows] :
-         {std::pair{"positive", &r.bias_positive}, std::pair{"negative", &r.bias_negative}}) {
-      json a = json::array();
-      for (const auto& b : *rows)
-        a.push_back({{"extension_mm", b.extension_mm},
-                     {"meso_force_N", b.meso_force_N},
-                     {"law_trellis_force_N", b.curve_force_N},
-                     {"eq2_shear_deg", b.eq2_shear_deg}});
-      if (!a.empty()) s[std::string("bias_check_") + sign] = a;
-    }
-    log->info("wrote {} ([[membrane_law]] '{}', {} + {} curve points)", laws.string(), o.name,
-              r.positive.curve.angle_deg.size(),
-              o.symmetric ? std::size_t{0} : r.negative.curve.angle_deg.size());
-  } else if (cc.method == "tow_bending") {
-    TowBendingCalibration b = cc.bending;
-    b.out_dir = dir / "runs";
-    const TowBendingResult r = calibrate_tow_bending(b);
-    s["E11f_Pa"] = r.E11f;
-    s["bending_length_m"] = r.bending_length;
-    s["target_bending_length_m"] = b.target_bending_length;
-    s["runs"] = r.runs;
-    s["converged"] = r.converged;
-    targets.push_back({{"quantity", "bending_length_m"},
-                       {"value", r.bending_length},
-                       {"target", b.target_bending_length},
-                       {"relative_tolerance", b.tolerance},
-                       {"source", "the tow's bending length (ASTM D1388), calibrated E11f"},
-                       {"met", r.converged}});
-    log->info("E11f = {:.6g} Pa gives a bending length of {:.6g} m (target {:.6g} m) after {} runs",
-              r.E11f, r.bending_length, b.target_bending_length, r.runs);
-    if (r.converged) {
-      write_file_atomically(laws, bending_laws(cc, r));
+  try {
+    if (cc.method == "macro") {
+      MacroCalibrationOptions o = cc.macro;
+      o.output = laws;
+      o.curves_csv = dir / "frame_curves.csv";
+      const MacroCalibration r = calibrate_macro(o);
+      for (const auto& n : r.notes) log->info("{}", n);
+      s["membrane_law"] = o.name;
+      s["curve_points_positive"] = r.positive.curve.angle_deg.size();
+      s["curve_points_negative"] = o.symmetric ? 0 : r.negative.curve.angle_deg.size();
+      s["symmetric"] = o.symmetric;
+      s["stitch_bars"] = o.stitch_bars;
+      // The bias coupons against the force the law gives an ideal trellis: shown, not a target
+      // (the meso coupon slips between its tows, the trellis does not).
+      for (const auto& [sign, rows] :
+           {std::pair{"positive", &r.bias_positive}, std::pair{"negative", &r.bias_negative}}) {
+        json a = json::array();
+        for (const auto& b : *rows)
+          a.push_back({{"extension_mm", b.extension_mm},
+                       {"meso_force_N", b.meso_force_N},
+                       {"law_trellis_force_N", b.curve_force_N},
+                       {"eq2_shear_deg", b.eq2_shear_deg}});
+        if (!a.empty()) s[std::string("bias_check_") + sign] = a;
+      }
+      log->info("wrote {} ([[membrane_law]] '{}', {} + {} curve points)", laws.string(), o.name,
+                r.positive.curve.angle_deg.size(),
+                o.symmetric ? std::size_t{0} : r.negative.curve.angle_deg.size());
+    } else if (cc.method == "tow_bending") {
+      TowBendingCalibration b = cc.bending;
+      b.out_dir = dir / "runs";
+      const TowBendingResult r = calibrate_tow_bending(b);
+      s["E11f_Pa"] = r.E11f;
+      s["bending_length_m"] = r.bending_length;
+      s["target_bending_length_m"] = b.target_bending_length;
+      s["runs"] = r.runs;
+      s["converged"] = r.converged;
+      targets.push_back({{"quantity", "bending_length_m"},
+                         {"value", r.bending_length},
+                         {"target", b.target_bending_length},
+                         {"relative_tolerance", b.tolerance},
+                         {"source", "the tow's bending length (ASTM D1388), calibrated E11f"},
+                         {"met", r.converged}});
+      log->info(
+          "E11f = {:.6g} Pa gives a bending length of {:.6g} m (target {:.6g} m) after {} runs",
+          r.E11f, r.bending_length, b.target_bending_length, r.runs);
+      if (r.converged) {
+        write_file_atomically(laws, bending_laws(cc, r));
+      } else {
+        s["status"] = "numerical_failure";
+        s["error"] =
+            fmt::format("not converged in {} runs (calibration.max_runs): no laws written", r.runs);
+        log->error("{}", s["error"].get<std::string>());
+        code = kNumericalFailure;
+      }
     } else {
-      s["status"] = "numerical_failure";
-      s["error"] =
-          fmt::format("not converged in {} runs (calibration.max_runs): no laws written", r.runs);
-      log->error("{}", s["error"].get<std::string>());
-      code = kNumericalFailure;
+      StitchCalibrationOptions o = cc.stitch;
+      o.out_dir = dir;
+      calibrate_stitch(o);
+      write_file_atomically(laws, slurp_file(dir / "stitch_law.toml"));
+      s["bar_law"] = o.law_name;
+      log->info("wrote {} ([[bar_law]] '{}')", laws.string(), o.law_name);
     }
-  } else {
-    StitchCalibrationOptions o = cc.stitch;
-    o.out_dir = dir;
-    calibrate_stitch(o);
-    write_file_atomically(laws, slurp_file(dir / "stitch_law.toml"));
-    s["bar_law"] = o.law_name;
-    log->info("wrote {} ([[bar_law]] '{}')", laws.string(), o.law_name);
+  } catch (const std::exception& e) {
+    // The folder says what stopped it (a frame run not completed, a law that cannot be fitted),
+    // as an engine run's does; the caller reports the error and its exit code.
+    s["status"] = dynamic_cast<const InputError*>(&e)       ? "bad_input"
+                  : dynamic_cast<const NumericalError*>(&e) ? "numerical_failure"
+                                                            : "failed";
+    s["error"] = e.what();
+    write_file_atomically(dir / "summary.json", s.dump(2) + "\n");
+    log->error("{}", e.what());
+    throw;
   }
   if (code == kSuccess) s["laws_file"] = kLawsFile;
   if (!targets.empty()) {
