@@ -108,13 +108,9 @@ void seat_plane(const TableReader& t, RigidTool& tool, const Mesh& mesh) {
   const V3& n = tool.surface.axis;
   for (auto node : tool.contact_nodes) {
     const auto p = mesh.node(static_cast<std::size_t>(node));
-    const V3 r{p[0] - tool.surface.point.x, p[1] - tool.surface.point.y,
-               p[2] - tool.surface.point.z};
-    nearest = std::min(nearest, r.x * n.x + r.y * n.y + r.z * n.z);
+    nearest = std::min(nearest, dot(V3{p[0], p[1], p[2]} - tool.surface.point, n));
   }
-  const double shift = nearest - tool.thickness - clearance;
-  tool.surface.point = V3{tool.surface.point.x + shift * n.x, tool.surface.point.y + shift * n.y,
-                          tool.surface.point.z + shift * n.z};
+  tool.surface.point += (nearest - tool.thickness - clearance) * n;
 }
 
 // A tool must start clear of its contact nodes: a node inside it would be thrown out by the

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -157,13 +156,6 @@ std::string bending_laws(const CalibrationCase& cc, const TowBendingResult& r) {
   return os.str();
 }
 
-std::string slurp_file(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
 }  // namespace
 
 CalibrationCase load_calibration_case(const fs::path& file,
@@ -278,7 +270,7 @@ int run_calibration_stage(const StageCall& call) {
       StitchCalibrationOptions o = cc.stitch;
       o.out_dir = dir;
       calibrate_stitch(o);
-      write_file_atomically(laws, slurp_file(dir / "stitch_law.toml"));
+      write_file_atomically(laws, read_file(dir / "stitch_law.toml"));
       s["bar_law"] = o.law_name;
       log->info("wrote {} ([[bar_law]] '{}')", laws.string(), o.law_name);
     }

@@ -582,9 +582,6 @@ void key_results_section(std::ostream& h, const json& stages,
 void targets_section(std::ostream& h, const json& stages, const std::map<std::string, json>& sums) {
   std::ostringstream rows;
   std::size_t n = 0, missed = 0;
-  const auto num = [](const json& v) {
-    return v.is_number() ? fmt::format("{:.4g}", v.get<double>()) : std::string("-");
-  };
   for (const auto& e : stages) {
     const std::string nm = e["name"].get<std::string>();
     const json& ss = sums.at(nm);
@@ -592,7 +589,7 @@ void targets_section(std::ostream& h, const json& stages, const std::map<std::st
     for (const auto& t : ss["targets"]) {
       const json& met = t.contains("met") ? t["met"] : json();
       std::string tol = "shown, not checked";
-      if (t.contains("tolerance")) tol = "&plusmn; " + num(t["tolerance"]);
+      if (t.contains("tolerance")) tol = "&plusmn; " + number(t, "tolerance");
       if (t.contains("relative_tolerance"))
         tol = fmt::format("&plusmn; {:.3g} %", 100 * t["relative_tolerance"].get<double>());
       std::string verdict = "-";
@@ -601,12 +598,12 @@ void targets_section(std::ostream& h, const json& stages, const std::map<std::st
                                   : "<span class=\"bad\">&#9888; missed</span>";
         missed += met.get<bool>() ? 0 : 1;
       }
-      std::string target = num(t.value("target", json()));
+      std::string target = number(t, "target");
       if (t.contains("target_quantity"))
         target += " (" + escape(t["target_quantity"].get<std::string>()) + ")";
       rows << "<tr><td>" << escape(nm) << "</td><td>" << escape(t.value("quantity", ""))
-           << "</td><td>" << num(t.value("value", json())) << "</td><td>" << target << "</td><td>"
-           << tol << "</td><td>" << verdict << "</td><td>" << escape(t.value("source", ""))
+           << "</td><td>" << number(t, "value") << "</td><td>" << target << "</td><td>" << tol
+           << "</td><td>" << verdict << "</td><td>" << escape(t.value("source", ""))
            << "</td></tr>\n";
       ++n;
     }
