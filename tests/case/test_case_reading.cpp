@@ -381,3 +381,27 @@ TEST(CaseReading, SeatedPlaneSitsItsClearanceFromTheNearestNode) {
     EXPECT_EQ(e.key(), "tool[0].seat_clearance");
   }
 }
+
+// [[output.target]]: exactly one of target and target_quantity, at most one tolerance; a bad one
+// names its key.
+TEST(CaseReading, OutputTargetNamesItsKeyWhenIllFormed) {
+  const auto key_of = [](const std::string& target) -> std::string {
+    const fs::path f =
+        write_case("target", contact_case("friction = 0.1\n") + "[[output.target]]\n" + target);
+    try {
+      (void)workflow::load_engine_case(f, {});
+    } catch (const InputError& e) {
+      return e.key();
+    }
+    return "(no error)";
+  };
+  EXPECT_EQ(key_of("quantity = \"x\"\ntarget = 1.0\nrelative_tolerance = 0.02\n"), "(no error)");
+  EXPECT_EQ(key_of("quantity = \"x\"\n"), "output.target[0].target");
+  EXPECT_EQ(key_of("quantity = \"x\"\ntarget = 1.0\ntarget_quantity = \"y\"\n"),
+            "output.target[0].target");
+  EXPECT_EQ(key_of("quantity = \"x\"\ntarget = 1.0\ntolerance = 0.1\nrelative_tolerance = 0.1\n"),
+            "output.target[0].tolerance");
+  EXPECT_EQ(key_of("quantity = \"x\"\ntarget = 1.0\ntolerance = -0.1\n"),
+            "output.target[0].tolerance");
+  EXPECT_EQ(key_of("target = 1.0\n"), "output.target[0].quantity");
+}
