@@ -10,6 +10,7 @@ namespace ncfsim::fem {
 
 struct HugePageAdvice {
   bool switched_off = false;      // NCFSIM_HUGE_PAGES=0
+  bool sanitized = false;         // an AddressSanitizer build: not asked for
   bool available = false;         // the kernel has transparent huge pages (not "never")
   std::size_t advised_bytes = 0;  // in mappings asked to use them
   std::size_t huge_bytes = 0;     // on 2 MB pages afterwards (AnonHugePages of the process)
@@ -18,7 +19,8 @@ struct HugePageAdvice {
 };
 
 /// Asks the kernel to back this process's large private anonymous mappings (each at least
-/// min_bytes: the heap and malloc's own mappings, where the model's arrays are) with 2 MB
+/// min_bytes and at least half resident: the heap and malloc's own mappings, where the model's
+/// arrays are) with 2 MB
 /// pages: MADV_HUGEPAGE for what is touched later, MADV_COLLAPSE for what is there now (region
 /// by region). Called again, it covers what was allocated since (a new mapping). Changes
 /// no value in memory; errors (an older kernel, no THP) leave the pages as they are.
