@@ -2,22 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <map>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
 #include "fem/elements/element_kind.hpp"
-#include "fem/io/atomic_file.hpp"
+#include "transfer/deck_common.hpp"
 
 namespace ncfsim::transfer {
 
-namespace {
-
-// Hexahedron faces in VTK corner numbers (0-based), outward, the order ExportTie uses.
-constexpr const auto& kFace = fem::kHex8Faces;
-// Abaqus C3D8 face labels S1..S6 for the same faces (S1: 1-2-3-4, S2: 5-8-7-6, S3: 1-5-6-2,
-// S4: 2-6-7-3, S5: 3-7-8-4, S6: 4-8-5-1).
-constexpr int kAbaqusFace[6] = {1, 2, 3, 4, 5, 6};
+namespace deck {
 
 void check(const ExportModel& m) {
   const std::size_t n = m.hex.size();
@@ -26,6 +24,13 @@ void check(const ExportModel& m) {
   for (auto k : m.material)
     if (k < 0 || static_cast<std::size_t>(k) >= m.materials.size())
       throw std::invalid_argument("export: an element names a material that does not exist");
+  if (!m.group.empty()) {
+    if (m.group.size() != n)
+      throw std::invalid_argument("export: one group per element expected (or none)");
+    for (auto g : m.group)
+      if (g < 0 || static_cast<std::size_t>(g) >= m.group_names.size())
+        throw std::invalid_argument("export: an element names a group that does not exist");
+  }
   const auto& st = m.stitches;
   for (const auto& b : st.bars)
     for (auto n : b)
@@ -33,128 +38,236 @@ void check(const ExportModel& m) {
         throw std::invalid_argument("export: a stitch bar names a node that does not exist");
   if (!st.bars.empty() && !(st.modulus > 0 && st.area > 0 && st.density > 0))
     throw std::invalid_argument("export: stitch bars need a positive modulus, area and density");
+  const auto& c = m.crush;
+  if (!c.enabled) return;
+  if (c.failure.size() != m.materials.size())
+    throw std::invalid_argument("export: a crush needs the failure data of every material");
+  if (c.bonds.size() != m.ties.size())
+    throw std::invalid_argument("export: a crush needs the cohesive law of every tie");
+  if (c.punch < 0 || static_cast<std::size_t>(c.punch) >= c.tools.size())
+    throw std::invalid_argument("export: a crush needs its punch among its tools");
+  if (!(c.end_time > 0)) throw std::invalid_argument("export: a crush needs a positive end time");
+  for (const auto& t : c.tools)
+    if ((t.sphere && !(t.radius > 0)) || (!t.sphere && !(t.half_size > 0)))
+      throw std::invalid_argument("export: tool '" + t.name + "' has no size");
 }
 
-}  // namespace
-
-void write_abaqus_inp(const std::filesystem::path& file, const ExportModel& m) {
-  check(m);
-  std::string s = "*HEADING\nncfsim impregnated model (units: m, kg, s, N, Pa)\n*NODE\n";
-  for (std::size_t i = 0; i < m.nodes.size(); ++i)
-    s += fmt::format("{}, {:.12e}, {:.12e}, {:.12e}\n", i + 1, m.nodes[i][0], m.nodes[i][1],
-                     m.nodes[i][2]);
-  // Local axes per element: a distribution read by one orientation.
-  s += "*DISTRIBUTION TABLE, NAME=tow_axes_table\nCOORD3D, COORD3D\n";
-  s += "*DISTRIBUTION, NAME=tow_axes, LOCATION=ELEMENT, TABLE=tow_axes_table\n, 1., 0., 0., 0., "
-       "1., 0.\n";
-  for (std::size_t e = 0; e < m.hex.size(); ++e) {
-    const auto& R = m.frame[e];
-    s += fmt::format("{}, {:.15g}, {:.15g}, {:.15g}, {:.15g}, {:.15g}, {:.15g}\n", e + 1, R[0],
-                     R[3], R[6], R[1], R[4], R[7]);
+std::vector<DeckPart> tow_parts(const ExportModel& m, std::vector<std::int32_t>& part_of) {
+  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> index;
+  for (std::size_t e = 0; e < m.hex.size(); ++e)
+    index[{m.group.empty() ? 0 : m.group[e], m.material[e]}] = 0;
+  std::vector<DeckPart> parts;
+  for (auto& [key, i] : index) {
+    i = static_cast<std::int32_t>(parts.size());
+    const std::string& mat = m.materials[static_cast<std::size_t>(key.second)].name;
+    parts.push_back({key.first, key.second,
+                     m.group_names.empty()
+                         ? mat
+                         : m.group_names[static_cast<std::size_t>(key.first)] + "_" + mat});
   }
-  s += "*ORIENTATION, NAME=tow_orientation, DEFINITION=COORDINATES, "
-       "SYSTEM=RECTANGULAR\ntow_axes\n3, 0.\n";
-  for (std::size_t k = 0; k < m.materials.size(); ++k) {
-    s += fmt::format("*ELEMENT, TYPE=C3D8R, ELSET=class_{}\n", k);
-    for (std::size_t e = 0; e < m.hex.size(); ++e) {
-      if (static_cast<std::size_t>(m.material[e]) != k) continue;
-      const auto& h = m.hex[e];
-      s += fmt::format("{}, {}, {}, {}, {}, {}, {}, {}, {}\n", e + 1, h[0] + 1, h[1] + 1, h[2] + 1,
-                       h[3] + 1, h[4] + 1, h[5] + 1, h[6] + 1, h[7] + 1);
-    }
-    const auto& mat = m.materials[k];
-    const auto& c = mat.elastic;
-    s +=
-        fmt::format("*SOLID SECTION, ELSET=class_{}, MATERIAL={}, ORIENTATION=tow_orientation\n,\n",
-                    k, mat.name);
-    s += fmt::format("*MATERIAL, NAME={}\n*DENSITY\n{:.6g}\n*ELASTIC, TYPE=ENGINEERING CONSTANTS\n",
-                     mat.name, mat.density);
-    s += fmt::format("{:.6g}, {:.6g}, {:.6g}, {:.6g}, {:.6g}, {:.6g}, {:.6g}, {:.6g}\n{:.6g}\n",
-                     c.E1, c.E2, c.E3, c.nu12, c.nu13, c.nu23, c.G12, c.G13, c.G23);
-  }
-  if (const auto& st = m.stitches; !st.bars.empty()) {
-    s += "*ELEMENT, TYPE=T3D2, ELSET=stitch\n";
-    for (std::size_t b = 0; b < st.bars.size(); ++b)
-      s += fmt::format("{}, {}, {}\n", m.hex.size() + b + 1, st.bars[b][0] + 1, st.bars[b][1] + 1);
-    s += fmt::format("*SOLID SECTION, ELSET=stitch, MATERIAL=STITCH\n{:.6g},\n", st.area);
-    s += fmt::format(
-        "*MATERIAL, NAME=STITCH\n*DENSITY\n{:.6g}\n*ELASTIC\n{:.6g}, 0.\n"
-        "** the yarn carries tension only (*NO COMPRESSION: Abaqus/Standard)\n*NO COMPRESSION\n",
-        st.density, st.modulus);
-  }
-  for (const auto& t : m.ties) {
-    for (const char* side : {"slave", "master"}) {
-      const auto& faces = std::string(side) == "slave" ? t.slave : t.master;
-      s += fmt::format("*SURFACE, TYPE=ELEMENT, NAME={}_{}\n", t.name, side);
-      for (auto [e, f] : faces) s += fmt::format("{}, S{}\n", e + 1, kAbaqusFace[f]);
-    }
-    s += fmt::format("*TIE, NAME={}, ADJUST=NO\n{}_slave, {}_master\n", t.name, t.name, t.name);
-  }
-  fem::io::atomic_write_text(file, s);
+  part_of.resize(m.hex.size());
+  for (std::size_t e = 0; e < m.hex.size(); ++e)
+    part_of[e] = index[{m.group.empty() ? 0 : m.group[e], m.material[e]}];
+  return parts;
 }
 
-void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& m) {
-  check(m);
-  std::string s = "*KEYWORD\n*TITLE\nncfsim impregnated model (units: m, kg, s, N, Pa)\n*NODE\n";
-  for (std::size_t i = 0; i < m.nodes.size(); ++i)
-    s += fmt::format("{:>8}{:>16.9e}{:>16.9e}{:>16.9e}\n", i + 1, m.nodes[i][0], m.nodes[i][1],
-                     m.nodes[i][2]);
-  for (std::size_t k = 0; k < m.materials.size(); ++k) {
-    const auto& c = m.materials[k].elastic;
-    s += fmt::format("*PART\n{}\n{:>10}{:>10}{:>10}\n", m.materials[k].name, k + 1, k + 1, k + 1);
-    s += fmt::format("*SECTION_SOLID\n{:>10}{:>10}\n", k + 1, 1);
-    s += fmt::format(
-        "*MAT_ORTHOTROPIC_ELASTIC\n{:>10}{:>10.4g}{:>10.4g}{:>10.4g}{:>10.4g}{:>10.4g}{:>10.4g}{:>"
-        "10.4g}\n",
-        k + 1, m.materials[k].density, c.E1, c.E2, c.E3, c.nu12 * c.E2 / c.E1, c.nu13 * c.E3 / c.E1,
-        c.nu23 * c.E3 / c.E2);
-    // AOPT = 2 (axes from vectors a and d); *ELEMENT_SOLID_ORTHO gives them per element.
-    s += fmt::format("{:>10.4g}{:>10.4g}{:>10.4g}{:>10.1f}\n", c.G12, c.G23, c.G13, 2.0);
-    s += fmt::format("{:>10}{:>10}{:>10}{:>10.1f}{:>10.1f}{:>10.1f}\n", 0, 0, 0, 1.0, 0.0, 0.0);
-    s += fmt::format("{:>10}{:>10}{:>10}{:>10.1f}{:>10.1f}{:>10.1f}\n", 0, 0, 0, 0.0, 1.0, 0.0);
-  }
-  s += "*ELEMENT_SOLID_ORTHO\n";
+std::vector<double> mean_element_length(const ExportModel& m) {
+  std::vector<double> volume(m.materials.size(), 0.0), count(m.materials.size(), 0.0);
   for (std::size_t e = 0; e < m.hex.size(); ++e) {
+    // Six tetrahedra on the 0-6 diagonal (VTK order): exact for a trilinear brick's volume.
     const auto& h = m.hex[e];
-    const auto& R = m.frame[e];
-    s += fmt::format("{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}\n", e + 1,
-                     m.material[e] + 1, h[0] + 1, h[1] + 1, h[2] + 1, h[3] + 1, h[4] + 1, h[5] + 1,
-                     h[6] + 1, h[7] + 1);
-    s += fmt::format("{:>16.9e}{:>16.9e}{:>16.9e}\n{:>16.9e}{:>16.9e}{:>16.9e}\n", R[0], R[3], R[6],
-                     R[1], R[4], R[7]);
-  }
-  if (const auto& st = m.stitches; !st.bars.empty()) {
-    const std::size_t id = m.materials.size() + 1;
-    s += fmt::format("*PART\nstitch\n{:>10}{:>10}{:>10}\n", id, id, id);
-    // A discrete beam with a cable area CA is a cable: its mass from the density and CA.
-    s += fmt::format("*SECTION_BEAM\n{:>10}{:>10}\n{:>10.4g}{:>10.4g}{:>10}{:>10.4g}\n", id, 6, 0.0,
-                     0.0, 0, st.area);
-    s += fmt::format("*MAT_CABLE_DISCRETE_BEAM\n{:>10}{:>10.4g}{:>10.4g}\n", id, st.density,
-                     st.modulus);
-    s += "*ELEMENT_BEAM\n";
-    for (std::size_t b = 0; b < st.bars.size(); ++b)
-      s += fmt::format("{:>8}{:>8}{:>8}{:>8}\n", m.hex.size() + b + 1, id, st.bars[b][0] + 1,
-                       st.bars[b][1] + 1);
-  }
-  int set = 0;
-  for (const auto& t : m.ties) {
-    int ids[2];
-    for (int side = 0; side < 2; ++side) {
-      ids[side] = ++set;
-      s += fmt::format("*SET_SEGMENT\n{:>10}\n", ids[side]);
-      for (auto [e, f] : side == 0 ? t.slave : t.master) {
-        const auto& h = m.hex[static_cast<std::size_t>(e)];
-        s += fmt::format("{:>10}{:>10}{:>10}{:>10}\n", h[kFace[f].corner[0]] + 1,
-                         h[kFace[f].corner[1]] + 1, h[kFace[f].corner[2]] + 1,
-                         h[kFace[f].corner[3]] + 1);
-      }
+    auto p = [&](int k) {
+      return m.nodes[static_cast<std::size_t>(h[static_cast<std::size_t>(k)])];
+    };
+    const int tet[6][3] = {{1, 2, 5}, {2, 6, 5}, {2, 3, 6}, {3, 7, 6}, {3, 0, 7}, {0, 4, 7}};
+    double v = 0;
+    for (const auto& t : tet) {
+      const auto a = p(0), b = p(t[0]), c = p(t[1]), d = p(t[2]);
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const double z[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+      v += (u[0] * (w[1] * z[2] - w[2] * z[1]) - u[1] * (w[0] * z[2] - w[2] * z[0]) +
+            u[2] * (w[0] * z[1] - w[1] * z[0])) /
+           6.0;
     }
-    s += fmt::format(
-        "*CONTACT_TIED_SURFACE_TO_SURFACE_ID\n{:>10}{:>10}\n{:>10}{:>10}{:>10}{:>10}\n\n\n",
-        set / 2, t.name, ids[0], ids[1], 0, 0);
+    const auto k = static_cast<std::size_t>(m.material[e]);
+    volume[k] += std::abs(v), count[k] += 1;
   }
-  s += "*END\n";
-  fem::io::atomic_write_text(file, s);
+  std::vector<double> length(m.materials.size(), 0.0);
+  for (std::size_t k = 0; k < length.size(); ++k)
+    if (count[k] > 0) length[k] = std::cbrt(volume[k] / count[k]);
+  return length;
+}
+
+ToolMesh tool_mesh(const ExportTool& t) {
+  ToolMesh mesh;
+  auto add = [&](const std::array<double, 3>& p) {
+    mesh.nodes.push_back(p);
+    return static_cast<std::int32_t>(mesh.nodes.size() - 1);
+  };
+  auto unit = [](std::array<double, 3> v) {
+    const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (auto& x : v) x /= n;
+    return v;
+  };
+  // Two unit vectors normal to d and to each other.
+  auto frame = [&](const std::array<double, 3>& d, std::array<double, 3>& e1,
+                   std::array<double, 3>& e2) {
+    const std::array<double, 3> r =
+        std::abs(d[0]) < 0.9 ? std::array<double, 3>{1, 0, 0} : std::array<double, 3>{0, 1, 0};
+    e1 = unit({r[1] * d[2] - r[2] * d[1], r[2] * d[0] - r[0] * d[2], r[0] * d[1] - r[1] * d[0]});
+    e2 = {d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2], d[0] * e1[1] - d[1] * e1[0]};
+  };
+  std::array<double, 3> e1, e2;
+  if (t.sphere) {
+    // The half facing the motion (the tip): pole along the velocity, or -axis when fixed.
+    const double vn = std::hypot(t.velocity[0], t.velocity[1], t.velocity[2]);
+    const std::array<double, 3> d =
+        vn > 0 ? unit(t.velocity) : std::array<double, 3>{-t.axis[0], -t.axis[1], -t.axis[2]};
+    frame(d, e1, e2);
+    constexpr int kRings = 16, kAround = 64;  // 5.6 deg facets: a 25 mm sphere within 0.03 mm
+    auto at = [&](double theta, double phi) {
+      std::array<double, 3> p;
+      for (int k = 0; k < 3; ++k)
+        p[static_cast<std::size_t>(k)] =
+            t.point[static_cast<std::size_t>(k)] +
+            t.radius * (std::cos(theta) * d[static_cast<std::size_t>(k)] +
+                        std::sin(theta) * (std::cos(phi) * e1[static_cast<std::size_t>(k)] +
+                                           std::sin(phi) * e2[static_cast<std::size_t>(k)]));
+      return p;
+    };
+    const std::int32_t pole = add(at(0, 0));
+    std::vector<std::int32_t> prev;
+    for (int i = 1; i <= kRings; ++i) {
+      std::vector<std::int32_t> ring;
+      for (int j = 0; j < kAround; ++j)
+        ring.push_back(
+            add(at(0.5 * std::numbers::pi * i / kRings, 2 * std::numbers::pi * j / kAround)));
+      for (int j = 0; j < kAround; ++j) {
+        const int jn = (j + 1) % kAround;
+        if (i == 1)
+          mesh.quads.push_back({pole, ring[static_cast<std::size_t>(j)],
+                                ring[static_cast<std::size_t>(jn)],
+                                ring[static_cast<std::size_t>(jn)]});
+        else
+          mesh.quads.push_back(
+              {prev[static_cast<std::size_t>(j)], ring[static_cast<std::size_t>(j)],
+               ring[static_cast<std::size_t>(jn)], prev[static_cast<std::size_t>(jn)]});
+      }
+      prev = ring;
+    }
+  } else {
+    frame(unit(t.axis), e1, e2);
+    constexpr int kSide = 8;
+    for (int j = 0; j <= kSide; ++j)
+      for (int i = 0; i <= kSide; ++i) {
+        const double a = t.half_size * (2.0 * i / kSide - 1),
+                     b = t.half_size * (2.0 * j / kSide - 1);
+        add({t.point[0] + a * e1[0] + b * e2[0], t.point[1] + a * e1[1] + b * e2[1],
+             t.point[2] + a * e1[2] + b * e2[2]});
+      }
+    for (int j = 0; j < kSide; ++j)
+      for (int i = 0; i < kSide; ++i) {
+        const std::int32_t n0 = j * (kSide + 1) + i;
+        mesh.quads.push_back({n0, n0 + 1, n0 + kSide + 2, n0 + kSide + 1});
+      }
+  }
+  // Outward: a sphere's facets away from its centre, a plane's along its normal (the body's side).
+  for (auto& q : mesh.quads) {
+    const auto& a = mesh.nodes[static_cast<std::size_t>(q[0])];
+    const auto& b = mesh.nodes[static_cast<std::size_t>(q[1])];
+    const auto& c = mesh.nodes[static_cast<std::size_t>(q[2])];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double nrm[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                           u[0] * w[1] - u[1] * w[0]};
+    double out[3];
+    for (int k = 0; k < 3; ++k)
+      out[k] = t.sphere ? a[static_cast<std::size_t>(k)] - t.point[static_cast<std::size_t>(k)]
+                        : t.axis[static_cast<std::size_t>(k)];
+    if (nrm[0] * out[0] + nrm[1] * out[1] + nrm[2] * out[2] < 0) {
+      if (q[2] == q[3])
+        std::swap(q[1], q[2]), q[3] = q[2];
+      else
+        std::swap(q[1], q[3]);
+    }
+  }
+  return mesh;
+}
+
+std::vector<std::array<double, 2>> ramp_curve(double ramp_time, double end_time) {
+  std::vector<std::array<double, 2>> c;
+  if (ramp_time > 0) {
+    for (int k = 0; k <= 10; ++k) {
+      const double s = k / 10.0;
+      c.push_back({ramp_time * s, s * s * (3 - 2 * s)});
+    }
+  } else {
+    c.push_back({0, 1});
+  }
+  c.push_back({std::max(10 * end_time, 2 * ramp_time), 1});
+  return c;
+}
+
+std::string field(double v, int width) {
+  // At least one blank before each number: fixed columns read it either way, a reader does too.
+  for (int p = 7; p >= 1; --p) {
+    std::string s = fmt::format("{:.{}g}", v, p);
+    if (static_cast<int>(s.size()) < width) return fmt::format("{:>{}}", s, width);
+  }
+  throw std::invalid_argument("export: " + fmt::format("{}", v) + " does not fit a deck field");
+}
+
+}  // namespace deck
+
+DeckContents deck_contents(const ExportModel& m, const std::string& format) {
+  DeckContents d;
+  const bool crush = m.crush.enabled;
+  d.carried.push_back(
+      fmt::format("{} nodes, {} hexahedra with their material axes", m.nodes.size(), m.hex.size()));
+  d.carried.push_back(fmt::format("{} orthotropic elastic materials (the transfer's Vf classes)",
+                                  m.materials.size()));
+  if (!m.stitches.bars.empty())
+    d.carried.push_back(fmt::format("{} kept stitch bars (tension only)", m.stitches.bars.size()));
+  if (format == "lsdyna") {
+    if (crush) {
+      d.carried.push_back(
+          "the tows' per-mode failure: *MAT_262 (strengths, fracture energies per mode, "
+          "transverse shear as strains)");
+      d.carried.push_back(fmt::format(
+          "{} resin-bond interfaces as tiebreak contacts that soften (OPTION 9: strengths, "
+          "mode I / II energies, B-K exponent)",
+          m.ties.size()));
+      d.carried.push_back(
+          fmt::format("{} rigid tools (shell meshes), the punch's prescribed "
+                      "velocity with its ramp, friction",
+                      m.crush.tools.size()));
+      if (m.crush.ply_contact) d.carried.push_back("the plies' contact with friction");
+      d.carried.push_back(
+          "end time, step safety factor, erosion on the step (DTMIN), energy "
+          "and contact-force outputs");
+      d.left_out.push_back(
+          "the crushed tows' residual compressive strength (MAT_262 has none: its crash front "
+          "softening SOFT is left at 1)");
+      d.left_out.push_back(
+          "the crack band raised per element where an element is too long for a mode's energy "
+          "(MAT_262 regularises with its own characteristic length)");
+    } else {
+      d.carried.push_back(fmt::format("{} tied interfaces (no failure)", m.ties.size()));
+      d.left_out.push_back(
+          "the failure law, the bonds' softening, tools, loading, controls (export a crush case "
+          "for them)");
+    }
+  } else {
+    d.carried.push_back(fmt::format("{} tied interfaces (*TIE, no failure)", m.ties.size()));
+    if (crush)
+      d.carried.push_back(
+          "the tows' strengths and fracture energies and the bonds' cohesive data, as comments");
+    d.left_out.push_back(
+        "the tows' per-mode damage: Abaqus/Explicit has none built in for solids (a VUMAT would "
+        "carry it); the bonds' softening, tools, loading and controls");
+  }
+  return d;
 }
 
 DeckCounts read_deck(const std::filesystem::path& file, const std::string& format) {
@@ -162,7 +275,6 @@ DeckCounts read_deck(const std::filesystem::path& file, const std::string& forma
   if (!in) throw std::runtime_error(file.string() + ": cannot be read");
   DeckCounts c;
   std::string line, block;
-  std::vector<std::string> pending;  // LS-DYNA: the two lines of an element
   auto numbers = [](const std::string& l) {
     std::vector<double> v;
     std::string t = l;
@@ -180,18 +292,28 @@ DeckCounts read_deck(const std::filesystem::path& file, const std::string& forma
     return v;
   };
   int ortho_line = 0;
+  bool first_data = false;  // the block's first data line
   while (std::getline(in, line)) {
-    if (line.empty()) continue;
+    if (line.empty() || line[0] == '$' || line.rfind("**", 0) == 0) continue;  // comments
     if (line[0] == '*') {
       block = line;
       ortho_line = 0;
+      first_data = true;
       if (format == "abaqus") {
         if (block.rfind("*ORIENTATION", 0) == 0) ++c.orientations;
         if (block.rfind("*MATERIAL", 0) == 0) ++c.materials;
         if (block.rfind("*TIE", 0) == 0) ++c.ties;
       } else {
-        if (block.rfind("*MAT_", 0) == 0) ++c.materials;
+        const auto has = [&](const char* key) { return block.find(key) != std::string::npos; };
+        if (block == "*MAT_RIGID")
+          ++c.rigid_parts;
+        else if (block.rfind("*MAT_", 0) == 0)
+          ++c.materials;
+        if (block == "*MAT_LAMINATED_FRACTURE_DAIMLER_CAMANHO") ++c.failure_materials;
         if (block.rfind("*CONTACT_TIED", 0) == 0) ++c.ties;
+        if (block.rfind("*CONTACT_", 0) == 0 && has("_TIEBREAK")) ++c.ties, ++c.softening_ties;
+        if (block.rfind("*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE", 0) == 0) ++c.contacts;
+        if (block == "*BOUNDARY_PRESCRIBED_MOTION_RIGID") ++c.motions;
       }
       continue;
     }
@@ -213,6 +335,10 @@ DeckCounts read_deck(const std::filesystem::path& file, const std::string& forma
         ++c.nodes;
       else if (block == "*ELEMENT_BEAM")
         ++c.elements, ++c.bars;
+      else if (block == "*ELEMENT_SHELL")
+        ++c.tool_elements;
+      else if (block == "*CONTROL_TERMINATION" && first_data)
+        c.end_time = fixed(line.substr(0, 10), 10).at(0);
       else if (block == "*ELEMENT_SOLID_ORTHO") {
         if (ortho_line % 3 == 0) {
           ++c.elements;
@@ -229,6 +355,7 @@ DeckCounts read_deck(const std::filesystem::path& file, const std::string& forma
         ++ortho_line;
       }
     }
+    first_data = false;
   }
   if (format == "abaqus" && c.orientations == 1 && !c.axes.empty()) c.orientations = c.axes.size();
   return c;

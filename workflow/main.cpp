@@ -245,6 +245,8 @@ struct FolderArgs {
   CLI::App* report = nullptr;
   CLI::App* exporter = nullptr;
   std::string folder, deck_format;
+  std::string export_output;  // export of a crush case: where the deck goes
+  std::vector<std::string> export_overrides;
 };
 
 void add_render_and_status(CLI::App& app, FolderArgs& a) {
@@ -261,8 +263,17 @@ void add_report_and_export(CLI::App& app, FolderArgs& a) {
   a.report = app.add_subcommand("report", "Write report.html for a finished run");
   a.report->add_option("outdir", a.folder, "Output folder of a run")->required();
   a.exporter = app.add_subcommand(
-      "export", "Write the impregnated model of a transfer run as an Abaqus or LS-DYNA deck");
-  a.exporter->add_option("outdir", a.folder, "Output folder of a transfer run")->required();
+      "export",
+      "Write a crush case as a deck another solver runs (LS-DYNA: the whole crush; Abaqus: the "
+      "model, elastic), or the impregnated model of a transfer run's folder");
+  a.exporter
+      ->add_option("source", a.folder,
+                   "A crush case file (kind = \"crush\"), or the output folder of a transfer run")
+      ->required();
+  a.exporter->add_option("-o,--output", a.export_output,
+                         "Crush case: folder for the deck (default results/<case name>_<format>)");
+  a.exporter->add_option("--set", a.export_overrides,
+                         "Crush case: override a case key, KEY=VALUE (repeatable)");
   a.exporter->add_option("--format", a.deck_format, "abaqus | lsdyna")
       ->required()
       ->check(CLI::IsMember({"abaqus", "lsdyna"}));
@@ -278,7 +289,21 @@ int run_render(const std::string& folder, wf::Verbosity verbosity) {
   return pngs.empty() ? wf::kOtherError : wf::kSuccess;
 }
 
-int run_export(const std::string& folder, const std::string& deck_format) {
+int run_export(const FolderArgs& a) {
+  const std::string& folder = a.folder;
+  const std::string& deck_format = a.deck_format;
+  if (std::filesystem::is_regular_file(folder)) {  // a crush case
+    const auto r = wf::export_crush_case(folder, a.export_overrides, deck_format, a.export_output);
+    std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie faces, %zu stitch bars\n",
+                r.result.file.c_str(), r.result.nodes, r.result.elements, r.result.materials,
+                r.result.tie_pairs, r.result.bars);
+    for (const auto& line : r.carried) std::printf("  carried: %s\n", line.c_str());
+    for (const auto& line : r.left_out) std::printf("  left out: %s\n", line.c_str());
+    return wf::kSuccess;
+  }
+  if (!a.export_output.empty() || !a.export_overrides.empty())
+    throw ncfsim::InputError(folder, "--output / --set",
+                             "given with a transfer run's folder: those are for a crush case file");
   require_output_folder(folder);
   const auto lock = wf::FolderLock::acquire(folder, "export");
   const auto r = wf::export_impregnated(folder, deck_format);
@@ -573,7 +598,7 @@ int main(int argc, char** argv) {
     if (*macro.cmd) return run_calibrate_macro(macro);
     if (*bending.cmd) return run_calibrate_tow_bending(bending);
     if (*folder.render) return run_render(folder.folder, verbosity);
-    if (*folder.exporter) return run_export(folder.folder, folder.deck_format);
+    if (*folder.exporter) return run_export(folder);
     if (*folder.status) return run_status(folder.folder);
     if (*folder.report) return run_report(folder.folder);
     return wf::kOtherError;

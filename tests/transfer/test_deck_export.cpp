@@ -1,10 +1,16 @@
 // Abaqus and LS-DYNA export of an impregnated model, read back: node, element, orientation,
-// material and tie counts, and one element's local axes round-trip.
+// material and tie counts, and one element's local axes round-trip. With a crush: the LS-DYNA
+// deck's failure materials, softening bonds, rigid tools (their facets on the sphere and the
+// plane, outward), the punch's motion and the end time read back; the tools' meshes and the
+// velocity ramp against their definitions; the Abaqus deck says what it leaves out.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
+#include "transfer/deck_common.hpp"
 #include "transfer/deck_export.hpp"
 
 namespace ncfsim {
@@ -52,6 +58,157 @@ TEST(DeckExport, AbaqusAndLsDynaDecksReadBackWithTheirCountsAndAxes) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "model.inp.tmp"));
   std::filesystem::remove_all(dir);
+}
+
+transfer::ExportModel two_tows_crushed() {
+  auto m = two_tows();
+  m.group = {0, 1};
+  m.group_names = {"ply1", "ply2"};
+  auto& c = m.crush;
+  c.enabled = true;
+  c.name = "two_tows_crush";
+  for (int k = 0; k < 2; ++k)
+    c.failure.push_back({2.8e9,
+                         1.7e9,
+                         60e6,
+                         200e6,
+                         80e6,
+                         50e6,
+                         {90e3, 80e3, 280, 800, 800, 500},
+                         0.2,
+                         {true, true, false, false, false, false}});
+  c.bonds.push_back({40e6, 60e6, 300, 1000, 1.45});
+  transfer::ExportTool punch;
+  punch.name = "punch";
+  punch.sphere = true;
+  punch.point = {1e-3, 0.5e-3, 0.026};
+  punch.radius = 0.025;
+  punch.velocity = {0, 0, -1.5};
+  punch.ramp_time = 2e-4;
+  punch.friction = 0.2;
+  transfer::ExportTool support;
+  support.name = "support";
+  support.point = {0, 0, -1e-4};
+  support.half_size = 0.01;
+  support.friction = 0.3;
+  c.tools = {punch, support};
+  c.punch = 0;
+  c.ply_contact = true;
+  c.ply_friction = 0.3;
+  c.end_time = 2.2e-3;
+  c.history_interval = 2.5e-5;
+  c.frame_interval = 1e-4;
+  c.erosion_step_ratio = 0.2;
+  return m;
+}
+
+std::string slurp_file(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(DeckExport, CrushDeckCarriesFailureBondsToolsMotionAndEndTime) {
+  const auto m = two_tows_crushed();
+  const auto dir = std::filesystem::temp_directory_path() / "ncfsim_deck_export_crush";
+  std::filesystem::create_directories(dir);
+  transfer::write_lsdyna_keyword(dir / "crush.k", m);
+  const auto c = transfer::read_deck(dir / "crush.k", "lsdyna");
+  std::size_t tool_nodes = 0, tool_facets = 0;
+  for (const auto& t : m.crush.tools) {
+    const auto mesh = transfer::deck::tool_mesh(t);
+    tool_nodes += mesh.nodes.size(), tool_facets += mesh.quads.size();
+  }
+  EXPECT_EQ(c.nodes, 12u + tool_nodes);
+  EXPECT_EQ(c.elements, 2u);
+  EXPECT_EQ(c.orientations, 2u);
+  EXPECT_EQ(c.materials, 2u);          // the tows' (the tools' rigid ones apart)
+  EXPECT_EQ(c.failure_materials, 2u);  // *MAT_262
+  EXPECT_EQ(c.ties, 1u);
+  EXPECT_EQ(c.softening_ties, 1u);  // tiebreak, not tied
+  EXPECT_EQ(c.rigid_parts, 2u);
+  EXPECT_EQ(c.tool_elements, tool_facets);
+  EXPECT_EQ(c.motions, 3u);   // the punch, each direction; the support held
+  EXPECT_EQ(c.contacts, 3u);  // punch, support, plies
+  EXPECT_DOUBLE_EQ(c.end_time, 2.2e-3);
+  const std::string deck = slurp_file(dir / "crush.k");
+  // The bond's law on its tiebreak card: OPTION 9, strengths, B-K (PARAM < 0), energies.
+  EXPECT_NE(deck.find("         9     4e+07     6e+07     -1.45       300      1000"),
+            std::string::npos);
+  // The fibre modes erode (DAF = DKF = 0), matrix and shear do not (DMF = DSF = 1).
+  EXPECT_NE(deck.find("        2         0         0         1         0\n"), std::string::npos);
+  EXPECT_NE(deck.find("$ left out: "), std::string::npos);
+  transfer::write_abaqus_inp(dir / "crush.inp", m);
+  const std::string inp = slurp_file(dir / "crush.inp");
+  EXPECT_NE(inp.find("** left out: the tows' per-mode damage"), std::string::npos);
+  EXPECT_NE(inp.find("** the crush's tow failure (not carried: elastic here): Xt 2.8e+09"),
+            std::string::npos);
+  EXPECT_NE(inp.find("** the crush's resin bond (not carried by *TIE): strengths N 4e+07"),
+            std::string::npos);
+  const auto a = transfer::read_deck(dir / "crush.inp", "abaqus");
+  EXPECT_EQ(a.elements, 2u);
+  EXPECT_EQ(a.materials, 2u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(DeckExport, ToolMeshesLieOnTheirSurfacesFacingTheBody) {
+  const auto m = two_tows_crushed();
+  const auto& punch = m.crush.tools[0];
+  const auto sphere = transfer::deck::tool_mesh(punch);
+  for (const auto& p : sphere.nodes) {
+    const double d[3] = {p[0] - punch.point[0], p[1] - punch.point[1], p[2] - punch.point[2]};
+    EXPECT_NEAR(std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), punch.radius, 1e-12);
+    EXPECT_LE(d[2], 1e-12);  // the half ahead of the punch's motion (-z)
+  }
+  auto outward = [](const transfer::deck::ToolMesh& mesh, std::size_t q,
+                    const std::array<double, 3>& dir) {
+    const auto& n = mesh.quads[q];
+    const auto& a = mesh.nodes[static_cast<std::size_t>(n[0])];
+    const auto& b = mesh.nodes[static_cast<std::size_t>(n[1])];
+    const auto& c = mesh.nodes[static_cast<std::size_t>(n[2])];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    return (u[1] * w[2] - u[2] * w[1]) * dir[0] + (u[2] * w[0] - u[0] * w[2]) * dir[1] +
+           (u[0] * w[1] - u[1] * w[0]) * dir[2];
+  };
+  for (std::size_t q = 0; q < sphere.quads.size(); ++q) {
+    const auto& a = sphere.nodes[static_cast<std::size_t>(sphere.quads[q][1])];
+    EXPECT_GT(
+        outward(sphere, q, {a[0] - punch.point[0], a[1] - punch.point[1], a[2] - punch.point[2]}),
+        0)
+        << q;
+  }
+  // The facets' chord error: under 0.05 mm on the 25 mm punch.
+  EXPECT_LT(punch.radius * (1 - std::cos(0.5 * 2 * M_PI / 64)), 5e-5);
+  const auto& support = m.crush.tools[1];
+  const auto plane = transfer::deck::tool_mesh(support);
+  for (const auto& p : plane.nodes) {
+    EXPECT_NEAR(p[2], support.point[2], 1e-15);
+    EXPECT_LE(std::max(std::abs(p[0]), std::abs(p[1])), support.half_size + 1e-15);
+  }
+  for (std::size_t q = 0; q < plane.quads.size(); ++q)
+    EXPECT_GT(outward(plane, q, support.axis), 0) << q;
+}
+
+TEST(DeckExport, VelocityRampIsTheEnginesCubicRamp) {
+  const auto c = transfer::deck::ramp_curve(2e-4, 2.2e-3);
+  ASSERT_GE(c.size(), 3u);
+  EXPECT_EQ(c.front()[1], 0.0);
+  for (const auto& [t, f] : c) {
+    const double s = std::min(t / 2e-4, 1.0);
+    EXPECT_NEAR(f, s * s * (3 - 2 * s), 1e-15) << t;
+  }
+  EXPECT_GE(c.back()[0], 2.2e-3);  // held to past the end
+  EXPECT_EQ(c.back()[1], 1.0);
+}
+
+TEST(DeckExport, NumbersFitTheirFieldsWithABlankBefore) {
+  for (const double v : {1566.91, 1.46158e11, 0.0156133201, -1.45, 3.07e14, 2.5e-5, 0.0})
+    ASSERT_EQ(transfer::deck::field(v).size(), 10u) << v;
+  EXPECT_EQ(transfer::deck::field(1.46158e11)[0], ' ');
+  // Six significant digits at least where a value has that many.
+  EXPECT_NEAR(std::stod(transfer::deck::field(0.0156133201)), 0.0156133201, 1e-5 * 0.0156133201);
 }
 
 TEST(DeckExport, ElementNamingAMissingMaterialIsRefused) {

@@ -5,17 +5,26 @@
 //    force filtered at CFC 600 in history.csv, peak force, stroke at peak, energy absorbed equal
 //    to the punch's work and the failed shares per mode in summary.json, the damage fields per
 //    mode and failed_mode in the frames, and the punch does not sink in (under 10 % of a ply);
+//  * `ncfsim export crush.toml` writes an LS-DYNA deck of the same crush that reads back against
+//    the transfer's model (nodes, hexahedra and their fibre axes, a failure law per Vf class, the
+//    two resin-bond interfaces as softening tiebreaks, the rigid punch and plate, the punch's
+//    motion, the end time) and an Abaqus deck that says what it leaves out (issue #46);
 //  * bad input exits 2 naming the key: a punch that starts inside the part, a fracture energy
 //    too small for the elements (snap-back), a [crush] punch that names no tool, a [model] that
 //    is not a transfer's result, [mesh] and [model] together.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "fem/io/stage_handoff.hpp"
 #include "tests/flat_blanket_case.hpp"
 #include "tests/workflow/cli_test_support.hpp"
+#include "transfer/deck_common.hpp"
+#include "transfer/deck_export.hpp"
 
 namespace ncfsim::test {
 namespace {
@@ -111,6 +120,76 @@ TEST(CliCrush, FlatBlanketIsPressedWithItsBalanceForceCurveAndDamage) {
   const auto fr = fem::io::read_last_frame(out / "results.h5");
   for (const char* field : {"damage_fibre_tension", "damage_matrix_compression", "failed_mode"})
     EXPECT_NE(fr.field(field), nullptr) << field;
+}
+
+TEST(CliCrush, CaseExportsAsDecksThatReadBackAgainstTheTransfer) {
+  Fixture f;
+  const fs::path out = f.dir / "deck";
+  const auto r = run_cli(f.crush("export", {"--format", "lsdyna", "-o", out.string()}));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("carried: the tows' per-mode failure"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("left out: "), std::string::npos) << r.output;
+  const auto transfer = fem::io::read_last_frame(f.dir / "transfer" / "results.h5");
+  const std::size_t n_hex = transfer.mesh.n_hex();
+  std::size_t n_class = 0, n_interface = 0;
+  {
+    std::ifstream in(f.dir / "transfer" / "materials.csv");
+    std::string line;
+    for (std::getline(in, line); std::getline(in, line);) n_class += !line.empty();
+    std::ifstream ties(f.dir / "transfer" / "ties.csv");
+    std::set<std::string> names;
+    for (std::getline(ties, line); std::getline(ties, line);)
+      names.insert(line.substr(0, line.find(',')));
+    n_interface = names.size();
+  }
+  transfer::ExportTool sphere, plane;
+  sphere.sphere = true, sphere.radius = 1, plane.half_size = 1;
+  const std::size_t tool_nodes = transfer::deck::tool_mesh(sphere).nodes.size() +
+                                 transfer::deck::tool_mesh(plane).nodes.size();
+  const auto c = transfer::read_deck(out / "hemisphere_crush.k", "lsdyna");
+  EXPECT_EQ(c.nodes, transfer.n_points() + tool_nodes);
+  EXPECT_EQ(c.elements, n_hex);
+  EXPECT_EQ(c.orientations, n_hex);
+  EXPECT_EQ(c.materials, n_class);
+  EXPECT_EQ(c.failure_materials, n_class);
+  EXPECT_EQ(n_interface, 2u);  // interply, intraply
+  EXPECT_EQ(c.softening_ties, n_interface);
+  EXPECT_EQ(c.rigid_parts, 2u);
+  EXPECT_EQ(c.motions, 3u);
+  EXPECT_EQ(c.contacts, 3u);  // punch, support, plies
+  EXPECT_DOUBLE_EQ(c.end_time, 1.5e-4);
+  // Each element's fibre axis is the transfer's (the crush renumbers the elements: compared as
+  // sets of lines, each rounded to 1e-7 and signed with its first component positive).
+  const auto* fibre = transfer.field("fibre_direction");
+  ASSERT_NE(fibre, nullptr);
+  const auto line = [](double x, double y, double z) {
+    const double eps = 1e-7;
+    if (x < -eps || (x < eps && (y < -eps || (y < eps && z < 0)))) x = -x, y = -y, z = -z;
+    return std::array<double, 3>{std::round(x / eps) * eps, std::round(y / eps) * eps,
+                                 std::round(z / eps) * eps};
+  };
+  std::vector<std::array<double, 3>> want, got;
+  for (std::size_t e = 0; e < n_hex; ++e)
+    want.push_back(line(fibre->values[3 * e], fibre->values[3 * e + 1], fibre->values[3 * e + 2]));
+  for (const auto& a : c.axes) got.push_back(line(a[0], a[1], a[2]));
+  std::sort(want.begin(), want.end());
+  std::sort(got.begin(), got.end());
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t e = 0; e < n_hex; ++e)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(got[e][static_cast<std::size_t>(k)], want[e][static_cast<std::size_t>(k)], 2e-7);
+  const auto a = run_cli(f.crush("export", {"--format", "abaqus", "-o", out.string()}));
+  ASSERT_EQ(a.code, 0) << a.output;
+  const auto ab = transfer::read_deck(out / "hemisphere_crush.inp", "abaqus");
+  EXPECT_EQ(ab.elements, n_hex);
+  EXPECT_EQ(ab.materials, n_class);
+  EXPECT_NE(slurp(out / "hemisphere_crush.inp").find("** left out: the tows' per-mode damage"),
+            std::string::npos);
+  // Not a crush: refused, naming the kind.
+  const auto bad = run_cli({"export", (kSource / "cases/verification/cantilever.toml").string(),
+                            "--format", "lsdyna", "-o", out.string()});
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("'case.kind'"), std::string::npos) << bad.output;
 }
 
 TEST(CliCrush, BadInputNamesTheKey) {

@@ -1,14 +1,21 @@
 #include "workflow/stages/transfer_export.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "fem/case/stage_kinds.hpp"
+#include "fem/contact/penalty_contact.hpp"
+#include "fem/contact/tied_contact.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/stage_handoff.hpp"
+#include "impact/tow_damage_material.hpp"
 #include "transfer/deck_export.hpp"
+#include "workflow/case/engine_case.hpp"
 #include "workflow/output/output_files.hpp"
 
 namespace ncfsim::workflow {
@@ -131,6 +138,178 @@ ExportResult export_impregnated(const std::filesystem::path& dir, const std::str
   r.bars = m.stitches.bars.size();
   r.materials = m.materials.size();
   r.tie_pairs = pairs;
+  return r;
+}
+
+namespace {
+
+// The model of a crush case as the exporter's data: the formed mesh with its frames and Vf
+// classes, the tow damage laws, the resin bonds, the kept stitches, the tools and the controls.
+transfer::ExportModel crush_export_model(const EngineCase& ec) {
+  const fem::Model& model = ec.model;
+  const std::string file = ec.file.string();
+  const auto& mesh = model.mesh;
+  const auto& hex = mesh.elements(fem::ElementKind::Hex8);
+  transfer::ExportModel m;
+  for (std::size_t i = 0; i < mesh.n_nodes(); ++i)
+    m.nodes.push_back({mesh.coords[3 * i], mesh.coords[3 * i + 1], mesh.coords[3 * i + 2]});
+  std::map<int, std::int32_t> group_of_part;
+  for (std::size_t e = 0; e < hex.size(); ++e) {
+    std::array<std::int32_t, 8> h{};
+    for (std::size_t k = 0; k < 8; ++k) h[k] = hex.conn[8 * e + k];
+    m.hex.push_back(h);
+    std::array<double, 9> f{};
+    const double* axes =
+        hex.material_axes.empty()
+            ? model.parts[static_cast<std::size_t>(hex.part[e])].material_axes.data()
+            : &hex.material_axes[9 * e];
+    std::copy(axes, axes + 9, f.begin());
+    m.frame.push_back(f);
+    const int part = hex.part[e];
+    const int mat = hex.material.empty() || hex.material[e] < 0
+                        ? model.parts[static_cast<std::size_t>(part)].material
+                        : hex.material[e];
+    m.material.push_back(mat);
+    if (!group_of_part.count(part)) {
+      group_of_part[part] = static_cast<std::int32_t>(m.group_names.size());
+      m.group_names.push_back(mesh.part_names[static_cast<std::size_t>(part)]);
+    }
+    m.group.push_back(group_of_part[part]);
+  }
+  auto& cr = m.crush;
+  cr.enabled = true;
+  cr.name = ec.name;
+  for (const auto& material : model.materials) {
+    const auto* tow = dynamic_cast<const impact::TowDamageMaterial*>(material.get());
+    if (!tow)
+      throw InputError(file, "material",
+                       "'" + material->name() +
+                           "' is not a tow_damage law: the export writes a crush of impregnated "
+                           "tows (a kind = \"crush\" case with [model])");
+    const auto& c = tow->constants();
+    m.materials.push_back({tow->name(), c.density, c.elastic});
+    const auto& X = c.strength;
+    transfer::ExportFailure f{X.Xt, X.Xc, X.Yt, X.Yc, X.S12, X.S23, {}, c.residual_compression};
+    std::copy(c.fracture_energy.begin(), c.fracture_energy.end(), f.fracture_energy.begin());
+    std::copy(c.erode_on.begin(), c.erode_on.end(), f.erode_on.begin());
+    cr.failure.push_back(f);
+  }
+  for (const auto& contact : model.contacts) {
+    if (const auto* tie = dynamic_cast<const fem::TiedContact*>(contact.get())) {
+      const auto& t = tie->config();
+      if (!t.slave_nodes.empty()) {  // the kept stitches' nodes on the tows
+        m.stitches.tied_nodes = t.slave_nodes;
+        continue;
+      }
+      if (t.face_pairs.empty())
+        throw InputError(file, "contact",
+                         "tie '" + t.name + "' is given by groups, not face pairs: not exported");
+      transfer::ExportTie x{t.name, {}, {}};
+      std::set<std::pair<std::int32_t, int>> slave, master;
+      for (const auto& p : t.face_pairs) {
+        slave.insert({p.slave_hex, p.slave_face});
+        master.insert({p.master_hex, p.master_face});
+      }
+      x.slave.assign(slave.begin(), slave.end());
+      x.master.assign(master.begin(), master.end());
+      m.ties.push_back(std::move(x));
+      cr.bonds.push_back(
+          {t.normal_strength, t.shear_strength, t.mode_i_energy, t.mode_ii_energy, t.bk_exponent});
+    } else if (const auto* pen = dynamic_cast<const fem::PenaltyContact*>(contact.get())) {
+      const auto& p = pen->config();
+      for (const auto& pair : p.pairs)
+        if (pair.first != pair.second) cr.ply_contact = true, cr.ply_friction = pair.friction;
+    }
+  }
+  // Kept stitches: the cured yarn's bars, a cable of a nominal 1 mm^2 with the law's E A and mass.
+  if (const auto& bars = mesh.elements(fem::ElementKind::Bar2); !bars.empty()) {
+    const auto& law = model.bar_laws.at(
+        static_cast<std::size_t>(model.parts[static_cast<std::size_t>(bars.part[0])].bar_law));
+    auto& st = m.stitches;
+    st.area = 1e-6;
+    st.modulus = law.max_slope() / st.area;
+    st.density = law.linear_density() / st.area;
+    for (std::size_t b = 0; b < bars.size(); ++b)
+      st.bars.push_back({bars.conn[2 * b], bars.conn[2 * b + 1]});
+  }
+  // Tools: the punch's sphere and the support's plane, at their places (a seated plane where the
+  // case seated it), a plane's plate wide enough for the model's footprint.
+  for (std::size_t t = 0; t < model.tools.size(); ++t) {
+    const auto& tool = model.tools[t];
+    const auto& srf = tool.surface;
+    if (srf.shape != fem::ToolShape::Sphere && srf.shape != fem::ToolShape::Plane)
+      throw InputError(file, "tool[" + std::to_string(t) + "].shape",
+                       "only a sphere or a plane tool is exported (the crush's punch and support)");
+    if (tool.motion.kind == fem::ToolMotion::Kind::Force)
+      throw InputError(file, "tool[" + std::to_string(t) + "].motion",
+                       "a force-driven tool is not exported (the crush's tools move at a velocity "
+                       "or are fixed)");
+    transfer::ExportTool x;
+    x.name = tool.name;
+    x.sphere = srf.shape == fem::ToolShape::Sphere;
+    x.point = {srf.point.x, srf.point.y, srf.point.z};
+    x.axis = {srf.axis.x, srf.axis.y, srf.axis.z};
+    x.radius = srf.radius;
+    if (tool.motion.kind == fem::ToolMotion::Kind::Velocity) {
+      x.velocity = {tool.motion.velocity.x, tool.motion.velocity.y, tool.motion.velocity.z};
+      x.ramp_time = tool.motion.ramp_time;
+    }
+    x.friction = tool.friction;
+    double reach = 0;
+    for (const auto& p : m.nodes) {
+      const fem::V3 d{p[0] - srf.point.x, p[1] - srf.point.y, p[2] - srf.point.z};
+      const double along = d.x * srf.axis.x + d.y * srf.axis.y + d.z * srf.axis.z;
+      reach = std::max(reach,
+                       std::sqrt(std::max(0.0, d.x * d.x + d.y * d.y + d.z * d.z - along * along)));
+    }
+    x.half_size = 1.2 * reach;
+    cr.tools.push_back(x);
+  }
+  cr.punch = ec.crush.punch;
+  const auto& time = model.time;
+  cr.end_time = time.end_time;
+  cr.history_interval = time.history_interval > 0 ? time.history_interval : time.end_time / 200;
+  cr.frame_interval = time.frame_interval > 0 ? time.frame_interval : time.end_time / 20;
+  cr.safety_factor = time.safety_factor;
+  cr.erosion_step_ratio = time.erosion_step_ratio;
+  for (int k = 0; k < impact::kModes; ++k)
+    cr.raised_elements[static_cast<std::size_t>(k)] =
+        ec.crush.crack_band.elements[static_cast<std::size_t>(k)];
+  return m;
+}
+
+}  // namespace
+
+CrushExport export_crush_case(const std::filesystem::path& case_file,
+                              const std::vector<std::string>& overrides, const std::string& format,
+                              const std::filesystem::path& out_dir) {
+  if (format != "abaqus" && format != "lsdyna")
+    throw InputError(case_file.string(), "--format",
+                     "'" + format + "' is not allowed; one of 'abaqus', 'lsdyna'");
+  const EngineCase ec = load_engine_case(case_file, overrides);
+  if (ec.kind != fem::stage_kind::kCrush || !ec.crush.enabled)
+    throw InputError(case_file.string(), "case.kind",
+                     "'" + ec.kind +
+                         "': the export of a case writes a crush (kind = \"crush\"); export a "
+                         "transfer run's folder for its model alone");
+  const transfer::ExportModel m = crush_export_model(ec);
+  const std::filesystem::path dir =
+      out_dir.empty() ? std::filesystem::path("results") / (ec.name + "_" + format) : out_dir;
+  std::filesystem::create_directories(dir);
+  CrushExport r;
+  r.result.file = dir / (ec.name + (format == "abaqus" ? ".inp" : ".k"));
+  if (format == "abaqus")
+    transfer::write_abaqus_inp(r.result.file, m);
+  else
+    transfer::write_lsdyna_keyword(r.result.file, m);
+  r.result.nodes = m.nodes.size();
+  r.result.elements = m.hex.size();
+  r.result.bars = m.stitches.bars.size();
+  r.result.materials = m.materials.size();
+  for (const auto& t : m.ties) r.result.tie_pairs += t.slave.size();
+  const auto contents = transfer::deck_contents(m, format);
+  r.carried = contents.carried;
+  r.left_out = contents.left_out;
   return r;
 }
 

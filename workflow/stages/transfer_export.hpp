@@ -4,6 +4,7 @@
 // users who run the crush in their own solver (transfer/deck_export.hpp).
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace ncfsim::workflow {
 
@@ -16,5 +17,18 @@ struct ExportResult {
 /// Throws InputError (file = the folder) when the folder holds no completed transfer run or the
 /// format is not abaqus / lsdyna.
 ExportResult export_impregnated(const std::filesystem::path& dir, const std::string& format);
+
+/// `ncfsim export CASE.toml --format ... [-o DIR] [--set ...]`: a crush case (kind = "crush") read
+/// as `ncfsim run` reads it, written as a deck that runs the same crush (transfer/deck_export.hpp:
+/// the tows' failure law, the resin bonds, the tools and the punch's motion, the controls) into
+/// DIR/<case name>.k or .inp (DIR empty: results/<case name>_<format>). Throws InputError for bad
+/// input or a case that is not a crush.
+struct CrushExport {
+  ExportResult result;
+  std::vector<std::string> carried, left_out;  // transfer::deck_contents
+};
+CrushExport export_crush_case(const std::filesystem::path& case_file,
+                              const std::vector<std::string>& overrides, const std::string& format,
+                              const std::filesystem::path& out_dir);
 
 }  // namespace ncfsim::workflow
