@@ -103,23 +103,36 @@ std::string contact_cards(const std::string& keyword, int cid, const std::string
   return s;
 }
 
-}  // namespace
+// The deck in named steps, numbering as it goes: parts, materials and elements after the tows'.
+struct LsDynaDeck {
+  const ExportModel& m;
+  const ExportCrush& cr;
+  std::string s;
+  std::vector<deck::ToolMesh> tools;
+  std::vector<std::size_t> tool_first_node, tool_part;
+  std::vector<deck::DeckPart> parts;
+  std::vector<std::int32_t> part_of;
+  std::vector<double> length;
+  std::size_t next_part = 0, next_mat = 0, next_elem = 0;
+  int set = 0, cid = 0;
 
-void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& m) {
-  deck::check(m);
-  const auto& cr = m.crush;
-  const bool crush = cr.enabled;
-  std::string s = "*KEYWORD\n*TITLE\n";
-  s += crush ? fmt::format("ncfsim crush '{}' (units: m, kg, s, N, Pa)\n", cr.name)
-             : "ncfsim impregnated model (units: m, kg, s, N, Pa)\n";
-  for (const auto& line : deck_contents(m, "lsdyna").carried) s += "$ carried: " + line + "\n";
-  for (const auto& line : deck_contents(m, "lsdyna").left_out) s += "$ left out: " + line + "\n";
-  if (crush) {
+  explicit LsDynaDeck(const ExportModel& model) : m(model), cr(model.crush) {}
+
+  void header() {
+    s = "*KEYWORD\n*TITLE\n";
+    s += cr.enabled ? fmt::format("ncfsim crush '{}' (units: m, kg, s, N, Pa)\n", cr.name)
+                    : "ncfsim impregnated model (units: m, kg, s, N, Pa)\n";
+    const auto contents = deck_contents(m, "lsdyna");
+    for (const auto& line : contents.carried) s += "$ carried: " + line + "\n";
+    for (const auto& line : contents.left_out) s += "$ left out: " + line + "\n";
     for (std::size_t k = 0; k < cr.raised_elements.size(); ++k)
-      if (cr.raised_elements[k] > 0)
+      if (cr.enabled && cr.raised_elements[k] > 0)
         s += fmt::format(
             "$ crack band: ncfsim raises the {} energy of {} elements too long for it\n",
             kModeNames[k], cr.raised_elements[k]);
+  }
+
+  void controls() {
     s += "*CONTROL_TERMINATION\n$   ENDTIM    ENDCYC     DTMIN\n";
     s += field(cr.end_time) + fmt::format("{:>10}", 0) + field(cr.erosion_step_ratio) + "\n";
     s += "*CONTROL_TIMESTEP\n$   DTINIT    TSSFAC      ISDO    TSLIMT     DT2MS      LCTM     "
@@ -133,46 +146,49 @@ void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& 
     s += "*DATABASE_BINARY_D3PLOT\n" + field(cr.frame_interval) + "\n";
   }
 
-  // Nodes: the model's, then the tools' facets'.
-  std::vector<deck::ToolMesh> tools;
-  for (const auto& t : cr.tools)
-    if (crush) tools.push_back(deck::tool_mesh(t));
-  s += "*NODE\n";
-  std::size_t n_node = 0;
-  auto node = [&](const std::array<double, 3>& p) {
-    s += fmt::format("{:>8}{:>16.9e}{:>16.9e}{:>16.9e}\n", ++n_node, p[0], p[1], p[2]);
-  };
-  for (const auto& p : m.nodes) node(p);
-  std::vector<std::size_t> tool_first_node;
-  for (const auto& t : tools) {
-    tool_first_node.push_back(n_node);
-    for (const auto& p : t.nodes) node(p);
+  // The model's nodes, then the tools' facets'.
+  void nodes() {
+    if (cr.enabled)
+      for (const auto& t : cr.tools) tools.push_back(deck::tool_mesh(t));
+    s += "*NODE\n";
+    std::size_t n_node = 0;
+    auto node = [&](const std::array<double, 3>& p) {
+      s += fmt::format("{:>8}{:>16.9e}{:>16.9e}{:>16.9e}\n", ++n_node, p[0], p[1], p[2]);
+    };
+    for (const auto& p : m.nodes) node(p);
+    for (const auto& t : tools) {
+      tool_first_node.push_back(n_node);
+      for (const auto& p : t.nodes) node(p);
+    }
   }
 
-  // Tows: a part per group and material, one solid section, a material per class.
-  std::vector<std::int32_t> part_of;
-  const auto parts = deck::tow_parts(m, part_of);
-  for (std::size_t p = 0; p < parts.size(); ++p)
-    s += fmt::format("*PART\n{}\n", parts[p].name) +
-         ints({static_cast<long long>(p + 1), 1, parts[p].material + 1});
-  s += "*SECTION_SOLID\n" + ints({1, 1});  // ELFORM 1: one point, as the engine's hexahedron
-  const auto length = deck::mean_element_length(m);
-  for (std::size_t k = 0; k < m.materials.size(); ++k)
-    s += crush ? failure_material(k + 1, m.materials[k], cr.failure[k], length[k])
-               : elastic_material(k + 1, m.materials[k]);
-  s += "*ELEMENT_SOLID_ORTHO\n";
-  for (std::size_t e = 0; e < m.hex.size(); ++e) {
-    const auto& h = m.hex[e];
-    const auto& R = m.frame[e];
-    s +=
-        fmt::format("{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}\n", e + 1, part_of[e] + 1,
-                    h[0] + 1, h[1] + 1, h[2] + 1, h[3] + 1, h[4] + 1, h[5] + 1, h[6] + 1, h[7] + 1);
-    s += fmt::format("{:>16.9e}{:>16.9e}{:>16.9e}\n{:>16.9e}{:>16.9e}{:>16.9e}\n", R[0], R[3], R[6],
-                     R[1], R[4], R[7]);
+  // A part per group and material, one solid section, a material per class.
+  void tows() {
+    parts = deck::tow_parts(m, part_of);
+    for (std::size_t p = 0; p < parts.size(); ++p)
+      s += fmt::format("*PART\n{}\n", parts[p].name) +
+           ints({static_cast<long long>(p + 1), 1, parts[p].material + 1});
+    s += "*SECTION_SOLID\n" + ints({1, 1});  // ELFORM 1: one point, as the engine's hexahedron
+    length = deck::mean_element_length(m);
+    for (std::size_t k = 0; k < m.materials.size(); ++k)
+      s += cr.enabled ? failure_material(k + 1, m.materials[k], cr.failure[k], length[k])
+                      : elastic_material(k + 1, m.materials[k]);
+    s += "*ELEMENT_SOLID_ORTHO\n";
+    for (std::size_t e = 0; e < m.hex.size(); ++e) {
+      const auto& h = m.hex[e];
+      const auto& R = m.frame[e];
+      s += fmt::format("{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}\n", e + 1,
+                       part_of[e] + 1, h[0] + 1, h[1] + 1, h[2] + 1, h[3] + 1, h[4] + 1, h[5] + 1,
+                       h[6] + 1, h[7] + 1);
+      s += fmt::format("{:>16.9e}{:>16.9e}{:>16.9e}\n{:>16.9e}{:>16.9e}{:>16.9e}\n", R[0], R[3],
+                       R[6], R[1], R[4], R[7]);
+    }
+    next_part = parts.size() + 1, next_mat = m.materials.size() + 1, next_elem = m.hex.size() + 1;
   }
-  std::size_t next_part = parts.size() + 1, next_mat = m.materials.size() + 1,
-              next_elem = m.hex.size() + 1;
-  if (const auto& st = m.stitches; !st.bars.empty()) {
+
+  void stitches() {
+    const auto& st = m.stitches;
+    if (st.bars.empty()) return;
     const std::size_t id = next_part++, mid = next_mat++;
     s += fmt::format("*PART\nstitch\n") +
          ints({static_cast<long long>(id), 2, static_cast<long long>(mid)});
@@ -187,8 +203,8 @@ void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& 
                        st.bars[b][1] + 1);
   }
 
-  int set = 0;
-  if (!crush) {
+  // The model alone: its interfaces tied.
+  void tied_interfaces() {
     for (const auto& t : m.ties) {
       const int a = ++set, b = ++set;
       s += segment_set(a, m, t.slave) + segment_set(b, m, t.master);
@@ -196,93 +212,119 @@ void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& 
           "*CONTACT_TIED_SURFACE_TO_SURFACE_ID\n{:>10}{:>10}\n{:>10}{:>10}{:>10}{:>10}\n\n\n",
           set / 2, t.name, a, b, 0, 0);
     }
-    s += "*END\n";
-    fem::io::atomic_write_text(file, s);
-    return;
   }
 
-  // Tools: rigid shells, a part and a rigid material each; the moving ones get a velocity
-  // curve (the engine's cubic ramp) per direction, the fixed ones are held.
-  s += "*SECTION_SHELL\n" + ints({3, 2}) + fields({1e-4, 1e-4, 1e-4, 1e-4});
-  s += "*DEFINE_CURVE\n" + ints({1}) + "$ the velocity's ramp (factor of the tool's velocity)\n";
-  for (const auto& [t, f] :
-       deck::ramp_curve(cr.tools[static_cast<std::size_t>(cr.punch)].ramp_time, cr.end_time))
-    s += fmt::format("{:>20.9e}{:>20.9e}\n", t, f);
-  std::vector<std::size_t> tool_part;
-  for (std::size_t t = 0; t < tools.size(); ++t) {
-    const auto& tool = cr.tools[t];
-    const std::size_t pid = next_part++, mid = next_mat++;
-    tool_part.push_back(pid);
-    const bool moving = std::hypot(tool.velocity[0], tool.velocity[1], tool.velocity[2]) > 0;
-    s += fmt::format("*PART\n{}\n", tool.name) +
-         ints({static_cast<long long>(pid), 3, static_cast<long long>(mid)});
-    s += "*MAT_RIGID\n$      MID        RO         E        PR\n" + fmt::format("{:>10}", mid) +
-         field(7850) + field(2.1e11) + field(0.3) + "\n";
-    s += "$      CMO      CON1      CON2\n" + fields({1, moving ? 0.0 : 7.0, 7});
-    s += "\n";
-    s += "*ELEMENT_SHELL\n";
-    for (const auto& q : tools[t].quads)
-      s += fmt::format("{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}\n", next_elem++, pid,
-                       tool_first_node[t] + static_cast<std::size_t>(q[0]) + 1,
-                       tool_first_node[t] + static_cast<std::size_t>(q[1]) + 1,
-                       tool_first_node[t] + static_cast<std::size_t>(q[2]) + 1,
-                       tool_first_node[t] + static_cast<std::size_t>(q[3]) + 1);
-    if (!moving) continue;
-    for (int d = 0; d < 3; ++d) {
-      s +=
-          "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n$      PID       DOF       VAD      LCID        SF\n";
-      s += ints({static_cast<long long>(pid), d + 1, 0, 1}).substr(0, 40) +
-           field(tool.velocity[static_cast<std::size_t>(d)]) + "\n";
+  // Rigid shells, a part and a rigid material each; the moving ones get a velocity curve (the
+  // engine's cubic ramp) per direction, the fixed ones are held.
+  void rigid_tools() {
+    s += "*SECTION_SHELL\n" + ints({3, 2}) + fields({1e-4, 1e-4, 1e-4, 1e-4});
+    s += "*DEFINE_CURVE\n" + ints({1}) + "$ the velocity's ramp (factor of the tool's velocity)\n";
+    for (const auto& [t, f] :
+         deck::ramp_curve(cr.tools[static_cast<std::size_t>(cr.punch)].ramp_time, cr.end_time))
+      s += fmt::format("{:>20.9e}{:>20.9e}\n", t, f);
+    for (std::size_t t = 0; t < tools.size(); ++t) {
+      const auto& tool = cr.tools[t];
+      const std::size_t pid = next_part++, mid = next_mat++;
+      tool_part.push_back(pid);
+      const bool moving = std::hypot(tool.velocity[0], tool.velocity[1], tool.velocity[2]) > 0;
+      s += fmt::format("*PART\n{}\n", tool.name) +
+           ints({static_cast<long long>(pid), 3, static_cast<long long>(mid)});
+      s += "*MAT_RIGID\n$      MID        RO         E        PR\n" + fmt::format("{:>10}", mid) +
+           field(7850) + field(2.1e11) + field(0.3) + "\n";
+      s += "$      CMO      CON1      CON2\n" + fields({1, moving ? 0.0 : 7.0, 7}) + "\n";
+      s += "*ELEMENT_SHELL\n";
+      const std::size_t first = tool_first_node[t] + 1;
+      for (const auto& q : tools[t].quads)
+        s += fmt::format(
+            "{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}\n", next_elem++, pid,
+            first + static_cast<std::size_t>(q[0]), first + static_cast<std::size_t>(q[1]),
+            first + static_cast<std::size_t>(q[2]), first + static_cast<std::size_t>(q[3]));
+      if (!moving) continue;
+      for (int d = 0; d < 3; ++d) {
+        s += "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n$      PID       DOF       VAD      LCID        "
+             "SF\n";
+        s += ints({static_cast<long long>(pid), d + 1, 0, 1}).substr(0, 40) +
+             field(tool.velocity[static_cast<std::size_t>(d)]) + "\n";
+      }
     }
   }
 
   // Part sets: every tow part (1), each group's (2 ...).
-  s += "*SET_PART_LIST\n" + ints({1});
-  for (std::size_t p = 0; p < parts.size(); ++p)
-    s += fmt::format("{:>10}", p + 1) + ((p % 8 == 7 || p + 1 == parts.size()) ? "\n" : "");
-  const std::size_t n_group = m.group_names.empty() ? 1 : m.group_names.size();
-  for (std::size_t g = 0; g < n_group; ++g) {
-    s += "*SET_PART_LIST\n" + ints({static_cast<long long>(g + 2)});
-    std::size_t k = 0;
+  std::size_t part_sets() {
+    s += "*SET_PART_LIST\n" + ints({1});
     for (std::size_t p = 0; p < parts.size(); ++p)
-      if (static_cast<std::size_t>(parts[p].group) == g)
-        s += fmt::format("{:>10}", p + 1) + (++k % 8 == 0 ? "\n" : "");
-    if (k % 8 != 0) s += "\n";
+      s += fmt::format("{:>10}", p + 1) + ((p % 8 == 7 || p + 1 == parts.size()) ? "\n" : "");
+    const std::size_t n_group = m.group_names.empty() ? 1 : m.group_names.size();
+    for (std::size_t g = 0; g < n_group; ++g) {
+      s += "*SET_PART_LIST\n" + ints({static_cast<long long>(g + 2)});
+      std::size_t k = 0;
+      for (std::size_t p = 0; p < parts.size(); ++p)
+        if (static_cast<std::size_t>(parts[p].group) == g)
+          s += fmt::format("{:>10}", p + 1) + (++k % 8 == 0 ? "\n" : "");
+      if (k % 8 != 0) s += "\n";
+    }
+    return n_group;
   }
-  int cid = 0;
-  if (const auto& tied = m.stitches.tied_nodes; !tied.empty()) {
-    s += "*SET_NODE_LIST\n" + ints({1});
-    for (std::size_t k = 0; k < tied.size(); ++k)
-      s += fmt::format("{:>10}", tied[k] + 1) + ((k % 8 == 7 || k + 1 == tied.size()) ? "\n" : "");
-    s += contact_cards("*CONTACT_TIED_NODES_TO_SURFACE_ID", ++cid, "stitch_on_tows", 1, 1, 4, 2, 0,
-                       0);
+
+  void contacts() {
+    const std::size_t n_group = part_sets();
+    if (const auto& tied = m.stitches.tied_nodes; !tied.empty()) {
+      s += "*SET_NODE_LIST\n" + ints({1});
+      for (std::size_t k = 0; k < tied.size(); ++k)
+        s +=
+            fmt::format("{:>10}", tied[k] + 1) + ((k % 8 == 7 || k + 1 == tied.size()) ? "\n" : "");
+      s += contact_cards("*CONTACT_TIED_NODES_TO_SURFACE_ID", ++cid, "stitch_on_tows", 1, 1, 4, 2,
+                         0, 0);
+    }
+    for (std::size_t t = 0; t < tools.size(); ++t)
+      s += contact_cards("*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID", ++cid, cr.tools[t].name, 1,
+                         static_cast<int>(tool_part[t]), 2, 3, cr.tools[t].friction, 1e-6);
+    if (cr.ply_contact && n_group >= 2)
+      s += contact_cards("*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID", ++cid, "plies", 2, 3, 2, 2,
+                         cr.ply_friction, 0);
   }
-  for (std::size_t t = 0; t < tools.size(); ++t)
-    s += contact_cards("*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID", ++cid, cr.tools[t].name, 1,
-                       static_cast<int>(tool_part[t]), 2, 3, cr.tools[t].friction, 1e-6);
-  if (cr.ply_contact && n_group >= 2)
-    s += contact_cards("*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID", ++cid, "plies", 2, 3, 2, 2,
-                       cr.ply_friction, 0);
-  // Resin bonds: tiebreak OPTION 9, a bilinear mixed-mode law with the B-K criterion (PARAM < 0)
-  // and the two energies; its normal stiffness that of a resin layer 1/50 of the element.
-  double e3 = 0;
-  for (const auto& mat : m.materials)
-    e3 += mat.elastic.E3 / static_cast<double>(m.materials.size());
-  double mean_length = 0;
-  for (double l : length) mean_length += l / static_cast<double>(length.size());
-  for (std::size_t i = 0; i < m.ties.size(); ++i) {
-    const auto& t = m.ties[i];
-    const auto& b = cr.bonds[i];
-    const int a = ++set, c = ++set;
-    s += segment_set(a, m, t.slave) + segment_set(c, m, t.master);
-    s += contact_cards("*CONTACT_AUTOMATIC_ONE_WAY_SURFACE_TO_SURFACE_TIEBREAK_ID", ++cid, t.name,
-                       a, c, 0, 0, cr.ply_friction, 0);
-    s += "$   OPTION      NFLS      SFLS     PARAM    ERATEN    ERATES     CT2CN        CN\n";
-    s += fields({9, b.normal_strength, b.shear_strength, -b.bk_exponent, b.mode_i_energy,
-                 b.mode_ii_energy, 1, 50 * e3 / mean_length});
+
+  // Resin bonds: tiebreak OPTION 9, a bilinear mixed-mode law with the B-K criterion
+  // (PARAM < 0) and the two energies; its normal stiffness that of a resin layer 1/50 of the
+  // element.
+  void resin_bonds() {
+    double e3 = 0, mean_length = 0;
+    for (const auto& mat : m.materials)
+      e3 += mat.elastic.E3 / static_cast<double>(m.materials.size());
+    for (double l : length) mean_length += l / static_cast<double>(length.size());
+    for (std::size_t i = 0; i < m.ties.size(); ++i) {
+      const auto& t = m.ties[i];
+      const auto& b = cr.bonds[i];
+      const int a = ++set, c = ++set;
+      s += segment_set(a, m, t.slave) + segment_set(c, m, t.master);
+      s += contact_cards("*CONTACT_AUTOMATIC_ONE_WAY_SURFACE_TO_SURFACE_TIEBREAK_ID", ++cid, t.name,
+                         a, c, 0, 0, cr.ply_friction, 0);
+      s += "$   OPTION      NFLS      SFLS     PARAM    ERATEN    ERATES     CT2CN        CN\n";
+      s += fields({9, b.normal_strength, b.shear_strength, -b.bk_exponent, b.mode_i_energy,
+                   b.mode_ii_energy, 1, 50 * e3 / mean_length});
+    }
   }
-  s += "*END\n";
-  fem::io::atomic_write_text(file, s);
+};
+
+}  // namespace
+
+void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& m) {
+  deck::check(m);
+  LsDynaDeck d(m);
+  d.header();
+  if (m.crush.enabled) d.controls();
+  d.nodes();
+  d.tows();
+  d.stitches();
+  if (m.crush.enabled) {
+    d.rigid_tools();
+    d.contacts();
+    d.resin_bonds();
+  } else {
+    d.tied_interfaces();
+  }
+  d.s += "*END\n";
+  fem::io::atomic_write_text(file, d.s);
 }
 
 }  // namespace ncfsim::transfer
