@@ -21,6 +21,9 @@ struct DeckPart {
 /// The parts in (group, material) order and each element's part index.
 std::vector<DeckPart> tow_parts(const ExportModel& m, std::vector<std::int32_t>& part_of);
 
+/// Volume of hexahedron e (six tetrahedra on its 0-6 diagonal: exact for a trilinear brick).
+double hex_volume(const ExportModel& m, std::size_t e);
+
 /// Mean element size per material, the cube root of the mean volume (m): the length the
 /// rupture strains of a law written as strains are made with (a crack band of the mean element).
 std::vector<double> mean_element_length(const ExportModel& m);

@@ -71,27 +71,28 @@ std::vector<DeckPart> tow_parts(const ExportModel& m, std::vector<std::int32_t>&
   return parts;
 }
 
+double hex_volume(const ExportModel& m, std::size_t e) {
+  const auto& h = m.hex[e];
+  auto p = [&](int k) { return m.nodes[static_cast<std::size_t>(h[static_cast<std::size_t>(k)])]; };
+  const int tet[6][3] = {{1, 2, 5}, {2, 6, 5}, {2, 3, 6}, {3, 7, 6}, {3, 0, 7}, {0, 4, 7}};
+  double v = 0;
+  for (const auto& t : tet) {
+    const auto a = p(0), b = p(t[0]), c = p(t[1]), d = p(t[2]);
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double z[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    v += (u[0] * (w[1] * z[2] - w[2] * z[1]) - u[1] * (w[0] * z[2] - w[2] * z[0]) +
+          u[2] * (w[0] * z[1] - w[1] * z[0])) /
+         6.0;
+  }
+  return std::abs(v);
+}
+
 std::vector<double> mean_element_length(const ExportModel& m) {
   std::vector<double> volume(m.materials.size(), 0.0), count(m.materials.size(), 0.0);
   for (std::size_t e = 0; e < m.hex.size(); ++e) {
-    // Six tetrahedra on the 0-6 diagonal (VTK order): exact for a trilinear brick's volume.
-    const auto& h = m.hex[e];
-    auto p = [&](int k) {
-      return m.nodes[static_cast<std::size_t>(h[static_cast<std::size_t>(k)])];
-    };
-    const int tet[6][3] = {{1, 2, 5}, {2, 6, 5}, {2, 3, 6}, {3, 7, 6}, {3, 0, 7}, {0, 4, 7}};
-    double v = 0;
-    for (const auto& t : tet) {
-      const auto a = p(0), b = p(t[0]), c = p(t[1]), d = p(t[2]);
-      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-      const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-      const double z[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-      v += (u[0] * (w[1] * z[2] - w[2] * z[1]) - u[1] * (w[0] * z[2] - w[2] * z[0]) +
-            u[2] * (w[0] * z[1] - w[1] * z[0])) /
-           6.0;
-    }
     const auto k = static_cast<std::size_t>(m.material[e]);
-    volume[k] += std::abs(v), count[k] += 1;
+    volume[k] += hex_volume(m, e), count[k] += 1;
   }
   std::vector<double> length(m.materials.size(), 0.0);
   for (std::size_t k = 0; k < length.size(); ++k)
@@ -229,6 +230,34 @@ DeckContents deck_contents(const ExportModel& m, const std::string& format) {
                                   m.materials.size()));
   if (!m.stitches.bars.empty())
     d.carried.push_back(fmt::format("{} kept stitch bars (tension only)", m.stitches.bars.size()));
+  if (format == "radioss") {
+    d.carried.push_back(
+        "the tows' per-mode failure: /MAT/LAW123 (Daimler-Pinho: strengths, fracture energies of "
+        "fibre tension, kinking, matrix tension, transverse and longitudinal shear, regularised by "
+        "V^(1/3)), each brick's axes in /INIBRI/ORTHO");
+    d.carried.push_back(fmt::format(
+        "{} resin-bond interfaces as /INTER/TYPE2 penalty ties (Spotflag 25)", m.ties.size()));
+    d.carried.push_back(fmt::format(
+        "{} rigid tools (shell facets on /RBODY), the punch's ramped velocity (/IMPVEL), tows on "
+        "tools /INTER/TYPE7 with friction",
+        m.crush.tools.size()));
+    d.carried.push_back(
+        "end time, erosion on the step (/DT/BRICK/DEL, its limit estimated from "
+        "the undeformed bricks), time histories of the tools and parts");
+    d.left_out.push_back(
+        "the plies' contact once debonded (TYPE7 refuses the plies' coincident "
+        "nodes; the ties hold them)");
+    d.left_out.push_back(
+        "a separate matrix-compression energy (LAW123 takes the transverse shear "
+        "one), the residual compressive strength, erode_on (LAW123 erodes a "
+        "brick when a mode's damage is complete)");
+    d.left_out.push_back(
+        "the bonds' failure: OpenRadioss's ties with rupture are kinematic, and its starter "
+        "refuses "
+        "the chains of ties a +-45 fabric has (a tow main to one neighbour, secondary to the next; "
+        "its error 556)");
+    return d;
+  }
   if (format == "lsdyna") {
     if (crush) {
       d.carried.push_back(
@@ -270,7 +299,10 @@ DeckContents deck_contents(const ExportModel& m, const std::string& format) {
   return d;
 }
 
+DeckCounts read_radioss_deck(const std::filesystem::path& file);
+
 DeckCounts read_deck(const std::filesystem::path& file, const std::string& format) {
+  if (format == "radioss") return read_radioss_deck(file);
   std::ifstream in(file);
   if (!in) throw std::runtime_error(file.string() + ": cannot be read");
   DeckCounts c;
@@ -358,6 +390,66 @@ DeckCounts read_deck(const std::filesystem::path& file, const std::string& forma
     first_data = false;
   }
   if (format == "abaqus" && c.orientations == 1 && !c.axes.empty()) c.orientations = c.axes.size();
+  return c;
+}
+
+DeckCounts read_radioss_deck(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error(file.string() + ": cannot be read");
+  DeckCounts c;
+  std::string line, block;
+  int line_in_block = 0;
+  auto reals = [&](const std::string& l) {
+    std::vector<double> v;
+    for (std::size_t p = 0; p + 20 <= l.size(); p += 20) v.push_back(std::stod(l.substr(p, 20)));
+    return v;
+  };
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (line[0] == '/') {
+      block = line;
+      line_in_block = 0;
+      const auto starts = [&](const char* key) { return line.rfind(key, 0) == 0; };
+      if (starts("/MAT/LAW123/")) ++c.materials, ++c.failure_materials;
+      if (starts("/MAT/ELAST/")) ++c.rigid_parts;
+      if (starts("/INTER/TYPE2/")) ++c.ties, ++c.softening_ties;
+      if (starts("/INTER/TYPE7/")) ++c.contacts;
+      if (starts("/IMPVEL/")) ++c.motions;
+      continue;
+    }
+    ++line_in_block;
+    if (block == "/NODE") {
+      ++c.nodes;
+    } else if (block.rfind("/BRICK/", 0) == 0) {
+      ++c.elements;
+    } else if (block.rfind("/SHELL/", 0) == 0 || block.rfind("/SH3N/", 0) == 0) {
+      ++c.tool_elements;
+    } else if (block == "/INIBRI/ORTHO") {
+      if (line_in_block % 3 == 1) {
+        ++c.orientations;
+        c.axes.emplace_back();
+      } else if (line_in_block % 3 == 2) {
+        const auto v = reals(line);
+        if (v.size() != 5)
+          throw std::runtime_error(file.string() + ": bad axes line '" + line + "'");
+        for (int k = 0; k < 5; ++k)
+          c.axes.back()[static_cast<std::size_t>(k)] = v[static_cast<std::size_t>(k)];
+      } else {
+        c.axes.back()[5] = reals(line).at(0);
+      }
+    }
+  }
+  // The rigid bodies' material is one; count the tools by their bodies instead.
+  c.rigid_parts = 0;
+  std::ifstream again(file);
+  while (std::getline(again, line))
+    if (line.rfind("/RBODY/", 0) == 0) ++c.rigid_parts;
+  auto engine = file;
+  engine.replace_filename(file.stem().string().substr(0, file.stem().string().size() - 5) +
+                          "_0001.rad");
+  std::ifstream e(engine);
+  for (std::string prev; std::getline(e, line); prev = line)
+    if (prev.rfind("/RUN/", 0) == 0) c.end_time = std::stod(line);
   return c;
 }
 

@@ -119,6 +119,10 @@ DeckContents deck_contents(const ExportModel& m, const std::string& format);
 /// Written atomically (fem/io/atomic_file.hpp); throw std::runtime_error naming the file.
 void write_abaqus_inp(const std::filesystem::path& file, const ExportModel& m);
 void write_lsdyna_keyword(const std::filesystem::path& file, const ExportModel& m);
+/// OpenRadioss block format, a crush only: dir/<name>_0000.rad (starter) and _0001.rad (engine),
+/// returned in that order.
+std::vector<std::filesystem::path> write_radioss_deck(const std::filesystem::path& dir,
+                                                      const ExportModel& m);
 
 struct DeckCounts {
   std::size_t nodes = 0, elements = 0, orientations = 0, materials = 0, ties = 0;
@@ -131,8 +135,8 @@ struct DeckCounts {
   std::vector<std::array<double, 6>>
       axes;  // per element as read: a1 and a2 (Abaqus) or a1 and v (LS-DYNA)
 };
-/// Reads back a deck written above ("abaqus" or "lsdyna"). Throws std::runtime_error on a
-/// malformed file.
+/// Reads back a deck written above ("abaqus", "lsdyna", or "radioss": the starter file, and the
+/// end time from the engine file beside it). Throws std::runtime_error on a malformed file.
 DeckCounts read_deck(const std::filesystem::path& file, const std::string& format);
 
 }  // namespace ncfsim::transfer

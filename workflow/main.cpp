@@ -28,6 +28,7 @@
 #include "workflow/calibrate/calibrate_tow_bending.hpp"
 #include "workflow/case/engine_case.hpp"
 #include "workflow/compare/compare.hpp"
+#include "workflow/compare/crush_compare.hpp"
 #include "workflow/figures/figures.hpp"
 #include "workflow/output/run_status.hpp"
 #include "workflow/report/report.hpp"
@@ -264,8 +265,8 @@ void add_report_and_export(CLI::App& app, FolderArgs& a) {
   a.report->add_option("outdir", a.folder, "Output folder of a run")->required();
   a.exporter = app.add_subcommand(
       "export",
-      "Write a crush case as a deck another solver runs (LS-DYNA: the whole crush; Abaqus: the "
-      "model, elastic), or the impregnated model of a transfer run's folder");
+      "Write a crush case as a deck another solver runs (LS-DYNA, OpenRadioss: the whole crush; "
+      "Abaqus: the model, elastic), or the impregnated model of a transfer run's folder");
   a.exporter
       ->add_option("source", a.folder,
                    "A crush case file (kind = \"crush\"), or the output folder of a transfer run")
@@ -274,9 +275,9 @@ void add_report_and_export(CLI::App& app, FolderArgs& a) {
                          "Crush case: folder for the deck (default results/<case name>_<format>)");
   a.exporter->add_option("--set", a.export_overrides,
                          "Crush case: override a case key, KEY=VALUE (repeatable)");
-  a.exporter->add_option("--format", a.deck_format, "abaqus | lsdyna")
+  a.exporter->add_option("--format", a.deck_format, "abaqus | lsdyna | radioss (a crush case)")
       ->required()
-      ->check(CLI::IsMember({"abaqus", "lsdyna"}));
+      ->check(CLI::IsMember({"abaqus", "lsdyna", "radioss"}));
 }
 
 int run_render(const std::string& folder, wf::Verbosity verbosity) {
@@ -539,6 +540,28 @@ void add_compare(CLI::App& app, CompareArgs& a) {
                     "Write into a folder that holds files ncfsim did not write");
 }
 
+struct CrushCompareArgs {
+  CLI::App* cmd = nullptr;
+  wf::CrushCompareOptions cmp;
+};
+
+void add_compare_crush(CLI::App& app, CrushCompareArgs& a) {
+  a.cmd = app.add_subcommand(
+      "compare-crush",
+      "Punch force against stroke of crush runs and other solvers' curves side by side: elastic "
+      "slope, peak, absorbed energy and their differences, one plot");
+  a.cmd
+      ->add_option("sources", a.cmp.sources,
+                   "Crush run folders and CSV files with stroke_m, force_N (time_s optional); "
+                   "LABEL=PATH names one")
+      ->required();
+  a.cmd->add_option("-o,--output", a.cmp.out_dir, "Output folder (default crush_comparison)");
+  a.cmd->add_option("--cfc", a.cmp.cfc,
+                    "SAE J211 class of the filtered force (default 600; 0: raw)");
+  a.cmd->add_flag("--overwrite", a.cmp.overwrite,
+                  "Write into a folder that holds files ncfsim did not write");
+}
+
 int run_compare(CompareArgs& a, wf::Verbosity verbosity) {
   wf::CompareOptions& cmp = a.cmp;
   cmp.verbosity = verbosity;
@@ -570,6 +593,7 @@ int main(int argc, char** argv) {
   TowBendingArgs bending;
   MacroCalibrationArgs macro;
   CompareArgs compare;
+  CrushCompareArgs compare_crush;
   add_run(app, run);
   add_check(app, check);
   add_render_and_status(app, folder);
@@ -580,6 +604,7 @@ int main(int argc, char** argv) {
   add_calibrate_tow_bending(*calibrate, bending);
   add_calibrate_macro(*calibrate, macro);
   add_compare(app, compare);
+  add_compare_crush(app, compare_crush);
 
   try {
     app.parse(argc, argv);
@@ -594,6 +619,10 @@ int main(int argc, char** argv) {
     if (*check.cmd) return run_check(check);
     if (*run.cmd) return run_run(run, verbosity, argc, argv);
     if (*compare.cmd) return run_compare(compare, verbosity);
+    if (*compare_crush.cmd) {
+      compare_crush.cmp.verbosity = verbosity;
+      return wf::compare_crushes(compare_crush.cmp);
+    }
     if (*stitch.cmd) return run_calibrate_stitch(stitch);
     if (*macro.cmd) return run_calibrate_macro(macro);
     if (*bending.cmd) return run_calibrate_tow_bending(bending);

@@ -152,6 +152,46 @@ TEST(DeckExport, CrushDeckCarriesFailureBondsToolsMotionAndEndTime) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(DeckExport, RadiossDeckCarriesLawAxesTiesToolsMotionAndEndTime) {
+  const auto m = two_tows_crushed();
+  const auto dir = std::filesystem::temp_directory_path() / "ncfsim_deck_export_radioss";
+  std::filesystem::create_directories(dir);
+  const auto files = transfer::write_radioss_deck(dir, m);
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0].filename(), "two_tows_crush_0000.rad");
+  EXPECT_EQ(files[1].filename(), "two_tows_crush_0001.rad");
+  const auto c = transfer::read_deck(files[0], "radioss");
+  std::size_t tool_nodes = 0, tool_facets = 0;
+  for (const auto& t : m.crush.tools) {
+    const auto mesh = transfer::deck::tool_mesh(t);
+    tool_nodes += mesh.nodes.size() + 1, tool_facets += mesh.quads.size();  // + the main node
+  }
+  EXPECT_EQ(c.nodes, 12u + tool_nodes);
+  EXPECT_EQ(c.elements, 2u);
+  EXPECT_EQ(c.materials, 2u);  // LAW123 per class
+  EXPECT_EQ(c.failure_materials, 2u);
+  EXPECT_EQ(c.ties, 1u);         // TYPE2
+  EXPECT_EQ(c.rigid_parts, 2u);  // RBODY
+  EXPECT_EQ(c.tool_elements, tool_facets);
+  EXPECT_EQ(c.motions, 3u);   // IMPVEL per direction
+  EXPECT_EQ(c.contacts, 2u);  // tows on punch and on support
+  EXPECT_DOUBLE_EQ(c.end_time, 2.2e-3);
+  // Each brick's axes as the model's: element 2's fibre at -45 deg, its second axis at +45.
+  ASSERT_EQ(c.orientations, 2u);
+  const double h = std::sqrt(0.5);
+  const double want[6] = {h, -h, 0, h, h, 0};
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(c.axes[1][static_cast<std::size_t>(k)], want[k], 1e-9);
+  // LAW123's energies: ENKINK (fibre compression), ENA (fibre tension), ENB (matrix tension), ENT
+  // (transverse shear), ENL (in-plane shear).
+  const std::string deck = slurp_file(files[0]);
+  EXPECT_NE(
+      deck.find("               80000               90000                 280                 "
+                "500                 800"),
+      std::string::npos);
+  EXPECT_NE(deck.find("# left out: the bonds' failure"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(DeckExport, ToolMeshesLieOnTheirSurfacesFacingTheBody) {
   const auto m = two_tows_crushed();
   const auto& punch = m.crush.tools[0];

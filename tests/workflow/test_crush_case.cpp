@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -185,11 +186,62 @@ TEST(CliCrush, CaseExportsAsDecksThatReadBackAgainstTheTransfer) {
   EXPECT_EQ(ab.materials, n_class);
   EXPECT_NE(slurp(out / "hemisphere_crush.inp").find("** left out: the tows' per-mode damage"),
             std::string::npos);
+  // OpenRadioss: starter and engine files, the same bricks and axes, a LAW123 per class.
+  const auto rr = run_cli(f.crush("export", {"--format", "radioss", "-o", out.string()}));
+  ASSERT_EQ(rr.code, 0) << rr.output;
+  const auto rad = transfer::read_deck(out / "hemisphere_crush_0000.rad", "radioss");
+  EXPECT_EQ(rad.elements, n_hex);
+  EXPECT_EQ(rad.orientations, n_hex);
+  EXPECT_EQ(rad.failure_materials, n_class);
+  EXPECT_EQ(rad.ties, n_interface);
+  EXPECT_EQ(rad.motions, 3u);
+  EXPECT_DOUBLE_EQ(rad.end_time, 1.5e-4);
   // Not a crush: refused, naming the kind.
   const auto bad = run_cli({"export", (kSource / "cases/verification/cantilever.toml").string(),
                             "--format", "lsdyna", "-o", out.string()});
   EXPECT_EQ(bad.code, 2) << bad.output;
   EXPECT_NE(bad.output.find("'case.kind'"), std::string::npos) << bad.output;
+}
+
+// `ncfsim compare-crush`: a crush run against a curve made from it with the force 10 % higher
+// reads +10 % slope, peak and energy at the same stroke of peak.
+TEST(CliCrush, CompareCrushMeasuresSlopePeakAndEnergyOfEachCurve) {
+  Fixture f;
+  const fs::path run = f.dir / "crush";
+  ASSERT_EQ(run_cli(f.crush("run", {"-o", run.string()})).code, 0);
+  const History h = read_history(run / "history.csv");
+  const fs::path csv = f.dir / "stiffer.csv";
+  {
+    std::ofstream o(csv);
+    o << std::setprecision(17) << "time_s,stroke_m,force_N\n";
+    for (std::size_t r = 0; r < h.rows.size(); ++r)
+      o << h.rows[r][h.column("time")] << "," << h.rows[r][h.column("punch_displacement_m")] << ","
+        << 1.1 * h.rows[r][h.column("punch_force_N")] << "\n";
+  }
+  const fs::path out = f.dir / "cmp";
+  // The raw force: this crush lasts 0.15 ms, shorter than CFC 600's filter settles.
+  const auto r = run_cli({"compare-crush", "ncfsim=" + run.string(), "stiffer=" + csv.string(),
+                          "-o", out.string(), "--cfc", "0"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto s = nlohmann::json::parse(slurp(out / "summary.json"));
+  ASSERT_EQ(s["sources"].size(), 2u);
+  SCOPED_TRACE(s.dump(1) + slurp(out / "comparison.md"));
+  for (const auto& x : s["sources"])
+    for (const char* k : {"elastic_slope_N_per_m", "peak_force_N", "energy_J"})
+      ASSERT_TRUE(x[k].is_number()) << k;
+  const auto& a = s["sources"][0];
+  const auto& b = s["sources"][1];
+  EXPECT_GT(a["peak_force_N"].get<double>(), 0);
+  EXPECT_GT(a["elastic_slope_N_per_m"].get<double>(), 0);
+  for (const char* k : {"elastic_slope_N_per_m", "peak_force_N", "energy_J"})
+    EXPECT_NEAR(b[k].get<double>() / a[k].get<double>(), 1.1, 1e-6) << k;
+  EXPECT_DOUBLE_EQ(b["peak_stroke_m"].get<double>(), a["peak_stroke_m"].get<double>());
+  EXPECT_TRUE(fs::exists(out / "crush_comparison.csv"));
+  EXPECT_NE(slurp(out / "comparison.md").find("+10.0 %, +10.0 %, +10.0 %"), std::string::npos)
+      << slurp(out / "comparison.md");
+  // A source that is neither: refused, naming it.
+  const auto bad = run_cli({"compare-crush", (f.dir / "nothing").string(), "-o", out.string()});
+  EXPECT_EQ(bad.code, 2) << bad.output;
 }
 
 TEST(CliCrush, BadInputNamesTheKey) {

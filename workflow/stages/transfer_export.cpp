@@ -283,9 +283,9 @@ transfer::ExportModel crush_export_model(const EngineCase& ec) {
 CrushExport export_crush_case(const std::filesystem::path& case_file,
                               const std::vector<std::string>& overrides, const std::string& format,
                               const std::filesystem::path& out_dir) {
-  if (format != "abaqus" && format != "lsdyna")
+  if (format != "abaqus" && format != "lsdyna" && format != "radioss")
     throw InputError(case_file.string(), "--format",
-                     "'" + format + "' is not allowed; one of 'abaqus', 'lsdyna'");
+                     "'" + format + "' is not allowed; one of 'abaqus', 'lsdyna', 'radioss'");
   const EngineCase ec = load_engine_case(case_file, overrides);
   if (ec.kind != fem::stage_kind::kCrush || !ec.crush.enabled)
     throw InputError(case_file.string(), "case.kind",
@@ -297,11 +297,15 @@ CrushExport export_crush_case(const std::filesystem::path& case_file,
       out_dir.empty() ? std::filesystem::path("results") / (ec.name + "_" + format) : out_dir;
   std::filesystem::create_directories(dir);
   CrushExport r;
-  r.result.file = dir / (ec.name + (format == "abaqus" ? ".inp" : ".k"));
-  if (format == "abaqus")
-    transfer::write_abaqus_inp(r.result.file, m);
-  else
-    transfer::write_lsdyna_keyword(r.result.file, m);
+  if (format == "radioss") {
+    r.result.file = transfer::write_radioss_deck(dir, m).front();
+  } else {
+    r.result.file = dir / (ec.name + (format == "abaqus" ? ".inp" : ".k"));
+    if (format == "abaqus")
+      transfer::write_abaqus_inp(r.result.file, m);
+    else
+      transfer::write_lsdyna_keyword(r.result.file, m);
+  }
   r.result.nodes = m.nodes.size();
   r.result.elements = m.hex.size();
   r.result.bars = m.stitches.bars.size();

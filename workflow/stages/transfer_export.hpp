@@ -21,8 +21,8 @@ ExportResult export_impregnated(const std::filesystem::path& dir, const std::str
 /// `ncfsim export CASE.toml --format ... [-o DIR] [--set ...]`: a crush case (kind = "crush") read
 /// as `ncfsim run` reads it, written as a deck that runs the same crush (transfer/deck_export.hpp:
 /// the tows' failure law, the resin bonds, the tools and the punch's motion, the controls) into
-/// DIR/<case name>.k or .inp (DIR empty: results/<case name>_<format>). Throws InputError for bad
-/// input or a case that is not a crush.
+/// DIR/<case name>.k, .inp or _0000.rad + _0001.rad (OpenRadioss; DIR empty: results/<case
+/// name>_<format>). Throws InputError for bad input or a case that is not a crush.
 struct CrushExport {
   ExportResult result;
   std::vector<std::string> carried, left_out;  // transfer::deck_contents
