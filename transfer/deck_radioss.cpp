@@ -23,7 +23,8 @@ std::string F(double v) { return fmt::format("{:>20.10g}", v); }
 
 // Ids of the starter deck's objects, in one place.
 constexpr int kToolMaterial = 9001, kToolProperty = 9001, kTowProperty = 1;
-constexpr int kAllTowNodes = 1;  // /GRNOD: every tow node (secondary of the tools' contacts)
+constexpr int kAllTowNodes = 1;   // /GRNOD: every tow node (secondary of the tools' contacts)
+constexpr int kTowSurface = 399;  // /SURF/PART/EXT: the tows' outer faces
 
 struct RadiossDeck {
   const ExportModel& m;
@@ -195,30 +196,44 @@ struct RadiossDeck {
     }
   }
 
-  // Tows on the tools: TYPE7 (every tow node on the tool's facets), Coulomb friction, the
-  // segments of eroded bricks removed.
+  // Cards of a TYPE7 (node group on a surface): Istf 4, the smaller of the two sides'
+  // stiffnesses (the steel shell's would set the step); Idel 1, eroded bricks' segments out;
+  // Irem_i2 3, nodes that resin-bond ties hold stay in.
+  void type7(long long id, const std::string& title, long long nodes, long long surf, double mu) {
+    s += fmt::format("/INTER/TYPE7/{}\n{}\n", id, title);
+    s += I(nodes) + I(surf) + I(4) + I(0) + I(0) + std::string(10, ' ') + I(0) + I(1) + I(0) +
+         I(0) + "\n";
+    s += F(0) + F(0) + F(0) + std::string(20, ' ') + I(0) + I(0) + "\n";
+    s += F(0) + F(0) + F(0) + F(0) + I(0) + I(3) + "\n";
+    s += F(0) + F(mu) + F(5e-6) + F(0) + F(0) + "\n";
+    s += std::string(7, ' ') + "000" + std::string(20, ' ') + I(0) + F(0) + F(0) + F(0) + "\n";
+    s += I(0) + I(0) + F(0) + I(0) + I(0) + I(0) + F(0) + I(0) + "\n";
+  }
+
+  // Tows on the tools, both ways for a sphere: the tows' nodes on its facets, and its facets'
+  // nodes on the tows' outer surface (a coarse dome has no node under the punch's pole: node on
+  // surface alone let the punch 0.26 mm into the CI dome's apex before it touched).
   void tool_contacts() {
     s += fmt::format("/GRNOD/NODE/{}\nall_tow_nodes\n", kAllTowNodes);
     for (std::size_t k = 0; k < m.nodes.size(); ++k)
       s += I(static_cast<long long>(k + 1)) + (k % 10 == 9 || k + 1 == m.nodes.size() ? "\n" : "");
+    s += fmt::format("/SURF/PART/EXT/{}\ntows_outer_surface\n", kTowSurface);
+    for (std::size_t p = 0; p < parts.size(); ++p)
+      s += I(static_cast<long long>(p + 1)) + (p % 10 == 9 || p + 1 == parts.size() ? "\n" : "");
     for (std::size_t t = 0; t < tools.size(); ++t) {
       const long long surf = 300 + static_cast<long long>(t);
       tool_surface(t, surf);
-      s += fmt::format("/INTER/TYPE7/{}\n{}_on_tows\n", t + 1, cr.tools[t].name);
-      // Istf 4: the smaller of the two sides' stiffnesses (the steel shell's would set the step).
-      s += I(kAllTowNodes) + I(surf) + I(4) + I(0) + I(0) + std::string(10, ' ') + I(0) + I(1) +
-           I(0) + I(0) + "\n";
-      s += F(0) + F(0) + F(0) + std::string(20, ' ') + I(0) + I(0) + "\n";
-      // Irem_i2 3: the tows' nodes that resin-bond ties hold stay in the contact (by default the
-      // starter takes a TYPE2 tie's secondary nodes out of it: the punch passed through them).
-      s += F(0) + F(0) + F(0) + F(0) + I(0) + I(3) + "\n";
-      s += F(0) + F(cr.tools[t].friction) + F(5e-6) + F(0) + F(0) + "\n";
-      s += std::string(7, ' ') + "000" + std::string(20, ' ') + I(0) + F(0) + F(0) + F(0) + "\n";
-      s += I(0) + I(0) + F(0) + I(0) + I(0) + I(0) + F(0) + I(0) + "\n";
+      const auto& tool = cr.tools[t];
+      type7(static_cast<long long>(t + 1), tool.name + "_on_tows", kAllTowNodes, surf,
+            tool.friction);
+      if (tool.sphere)
+        type7(static_cast<long long>(tools.size() + t + 1), "tows_on_" + tool.name,
+              100 + static_cast<long long>(t), kTowSurface, tool.friction);
     }
   }
 
-  // Resin bonds: TYPE2 penalty ties (Spotflag 25), which do not fail. Its ties with rupture
+  // Resin bonds: TYPE2 penalty ties (Spotflag 25, a tenth of the default stiffness), which do not
+  // fail. Its ties with rupture
   // (Spotflag 20-22) are kinematic, and the starter refuses a kinematic tie whose main node is
   // another's secondary (error 556): the dome's bonds form such chains (a tow is main to one
   // neighbour and secondary to the next, and the plies cross each other's tows).
@@ -244,7 +259,9 @@ struct RadiossDeck {
       }
       s += fmt::format("/INTER/TYPE2/{}\n{}\n", 100 + i, t.name);
       s += I(group) + I(surf) + I(0) + I(25) + I(0) + I(0) + I(0) + I(0) + F(0) + "\n";
-      s += F(0) + F(0) + std::string(20, ' ') + I(0) + "\n";
+      // Stfac 0.1: at the default stiffness the ties set the step and blew the CI dome's crush
+      // up some 20 us after the punch touched it.
+      s += F(0.1) + F(0) + std::string(20, ' ') + I(0) + "\n";
     }
   }
 

@@ -174,7 +174,7 @@ TEST(DeckExport, RadiossDeckCarriesLawAxesTiesToolsMotionAndEndTime) {
   EXPECT_EQ(c.rigid_parts, 2u);  // RBODY
   EXPECT_EQ(c.tool_elements, tool_facets);
   EXPECT_EQ(c.motions, 3u);   // IMPVEL per direction
-  EXPECT_EQ(c.contacts, 2u);  // tows on punch and on support
+  EXPECT_EQ(c.contacts, 3u);  // tows on the punch both ways (a sphere), on the support
   EXPECT_DOUBLE_EQ(c.end_time, 2.2e-3);
   // Each brick's axes as the model's: element 2's fibre at -45 deg, its second axis at +45.
   ASSERT_EQ(c.orientations, 2u);
