@@ -231,7 +231,18 @@ struct LsDynaDeck {
            ints({static_cast<long long>(pid), 3, static_cast<long long>(mid)});
       s += "*MAT_RIGID\n$      MID        RO         E        PR\n" + fmt::format("{:>10}", mid) +
            field(7850) + field(2.1e11) + field(0.3) + "\n";
-      s += "$      CMO      CON1      CON2\n" + fields({1, moving ? 0.0 : 7.0, 7}) + "\n";
+      // CON1: the translations at rest held (a zero SF reads as 1, so a direction at rest gets no
+      // prescribed motion: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all).
+      const bool rx = tool.velocity[0] == 0, ry = tool.velocity[1] == 0, rz = tool.velocity[2] == 0;
+      const double con1 = rx && ry && rz ? 7
+                          : rx && ry     ? 4
+                          : ry && rz     ? 5
+                          : rz && rx     ? 6
+                          : rx           ? 1
+                          : ry           ? 2
+                          : rz           ? 3
+                                         : 0;
+      s += "$      CMO      CON1      CON2\n" + fields({1, con1, 7}) + "\n";
       s += "*ELEMENT_SHELL\n";
       const std::size_t first = tool_first_node[t] + 1;
       for (const auto& q : tools[t].quads)
@@ -241,6 +252,7 @@ struct LsDynaDeck {
             first + static_cast<std::size_t>(q[2]), first + static_cast<std::size_t>(q[3]));
       if (!moving) continue;
       for (int d = 0; d < 3; ++d) {
+        if (tool.velocity[static_cast<std::size_t>(d)] == 0) continue;
         s += "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n$      PID       DOF       VAD      LCID        "
              "SF\n";
         s += ints({static_cast<long long>(pid), d + 1, 0, 1}).substr(0, 40) +

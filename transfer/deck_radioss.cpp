@@ -170,12 +170,16 @@ struct RadiossDeck {
            I(static_cast<long long>(tool_main_node[t])) + I(0) + I(0) + I(0) + F(0) + I(group) +
            I(0) + I(0) + I(0) + "\n" + F(0) + F(0) + F(0) + "\n" + F(0) + F(0) + F(0) + "\n" +
            I(0) + I(0) + I(0) + "\n";
-      const bool moving = std::hypot(tool.velocity[0], tool.velocity[1], tool.velocity[2]) > 0;
-      s += fmt::format("/BCS/{}\n{}_held\n", t + 1, tool.name) +
-           (moving ? "   000 111" : "   111 111") + I(0) + I(main) + "\n";
-      if (!moving) continue;
+      // Held in every direction it does not move along (IMPVEL takes a zero scale for 1, so a
+      // direction at rest is fixed by the BCS instead), and in rotation.
+      std::string held = "   ";
+      for (int d = 0; d < 3; ++d)
+        held += tool.velocity[static_cast<std::size_t>(d)] == 0 ? '1' : '0';
+      s += fmt::format("/BCS/{}\n{}_held\n", t + 1, tool.name) + held + " 111" + I(0) + I(main) +
+           "\n";
       for (int d = 0; d < 3; ++d) {
         const double v = tool.velocity[static_cast<std::size_t>(d)];
+        if (v == 0) continue;
         s += fmt::format("/IMPVEL/{}\n{}_{}\n", 10 * (t + 1) + static_cast<std::size_t>(d),
                          tool.name, "XYZ"[d]) +
              I(1) + fmt::format("{:>10}", "XYZ"[d]) + I(0) + I(0) + I(main) + I(0) + I(0) + "\n" +

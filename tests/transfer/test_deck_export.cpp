@@ -129,7 +129,7 @@ TEST(DeckExport, CrushDeckCarriesFailureBondsToolsMotionAndEndTime) {
   EXPECT_EQ(c.softening_ties, 1u);  // tiebreak, not tied
   EXPECT_EQ(c.rigid_parts, 2u);
   EXPECT_EQ(c.tool_elements, tool_facets);
-  EXPECT_EQ(c.motions, 3u);   // the punch, each direction; the support held
+  EXPECT_EQ(c.motions, 1u);   // the punch along its motion; the rest held (CON1)
   EXPECT_EQ(c.contacts, 3u);  // punch, support, plies
   EXPECT_DOUBLE_EQ(c.end_time, 2.2e-3);
   const std::string deck = slurp_file(dir / "crush.k");
@@ -139,6 +139,9 @@ TEST(DeckExport, CrushDeckCarriesFailureBondsToolsMotionAndEndTime) {
   // The fibre modes erode (DAF = DKF = 0), matrix and shear do not (DMF = DSF = 1).
   EXPECT_NE(deck.find("        2         0         0         1         0\n"), std::string::npos);
   EXPECT_NE(deck.find("$ left out: "), std::string::npos);
+  // The punch moves along z only: x and y held by its rigid material (CON1 4), the support fully.
+  EXPECT_NE(deck.find("         1         4         7\n"), std::string::npos);
+  EXPECT_NE(deck.find("         1         7         7\n"), std::string::npos);
   transfer::write_abaqus_inp(dir / "crush.inp", m);
   const std::string inp = slurp_file(dir / "crush.inp");
   EXPECT_NE(inp.find("** left out: the tows' per-mode damage"), std::string::npos);
@@ -173,7 +176,7 @@ TEST(DeckExport, RadiossDeckCarriesLawAxesTiesToolsMotionAndEndTime) {
   EXPECT_EQ(c.ties, 1u);         // TYPE2
   EXPECT_EQ(c.rigid_parts, 2u);  // RBODY
   EXPECT_EQ(c.tool_elements, tool_facets);
-  EXPECT_EQ(c.motions, 3u);   // IMPVEL per direction
+  EXPECT_EQ(c.motions, 1u);   // IMPVEL along the motion; the rest held (BCS)
   EXPECT_EQ(c.contacts, 3u);  // tows on the punch both ways (a sphere), on the support
   EXPECT_DOUBLE_EQ(c.end_time, 2.2e-3);
   // Each brick's axes as the model's: element 2's fibre at -45 deg, its second axis at +45.
@@ -189,6 +192,9 @@ TEST(DeckExport, RadiossDeckCarriesLawAxesTiesToolsMotionAndEndTime) {
                 "500                 800"),
       std::string::npos);
   EXPECT_NE(deck.find("# left out: the bonds' failure"), std::string::npos);
+  // The punch held in x, y and rotation (its z driven), the support in everything.
+  EXPECT_NE(deck.find("   110 111"), std::string::npos);
+  EXPECT_NE(deck.find("   111 111"), std::string::npos);
   std::filesystem::remove_all(dir);
 }
 

@@ -121,11 +121,17 @@ CsvTable read_csv(const std::filesystem::path& file) {
   CsvTable t;
   std::string line;
   if (!std::getline(in, line)) throw std::runtime_error(file.string() + " is empty");
+  // A file written on Windows (or by Python's csv module) ends its lines with CR LF.
+  const auto chomp = [](std::string& l) {
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+  };
+  chomp(line);
   {
     std::stringstream ss(line);
     for (std::string c; std::getline(ss, c, ',');) t.columns.push_back(c);
   }
   while (std::getline(in, line)) {
+    chomp(line);
     if (line.empty()) continue;
     std::vector<double> row;
     std::stringstream ss(line);
