@@ -411,7 +411,7 @@ DeckCounts read_radioss_deck(const std::filesystem::path& file) {
       line_in_block = 0;
       const auto starts = [&](const char* key) { return line.rfind(key, 0) == 0; };
       if (starts("/MAT/LAW123/")) ++c.materials, ++c.failure_materials;
-      if (starts("/MAT/ELAST/")) ++c.rigid_parts;
+      if (starts("/RBODY/")) ++c.rigid_parts;  // a tool each
       if (starts("/INTER/TYPE2/")) ++c.ties, ++c.softening_ties;
       if (starts("/INTER/TYPE7/")) ++c.contacts;
       if (starts("/IMPVEL/")) ++c.motions;
@@ -439,11 +439,6 @@ DeckCounts read_radioss_deck(const std::filesystem::path& file) {
       }
     }
   }
-  // The rigid bodies' material is one; count the tools by their bodies instead.
-  c.rigid_parts = 0;
-  std::ifstream again(file);
-  while (std::getline(again, line))
-    if (line.rfind("/RBODY/", 0) == 0) ++c.rigid_parts;
   auto engine = file;
   engine.replace_filename(file.stem().string().substr(0, file.stem().string().size() - 5) +
                           "_0001.rad");
