@@ -31,22 +31,28 @@ struct CohesiveState {
 /// and ds (sliding magnitude >= 0); updates the state (irreversible).
 inline void cohesive_tractions(const CohesiveLaw& law, double dn, double ds, CohesiveState& st,
                                double& tn, double& ts) {
-  const double dn0 = law.N / law.K, ds0 = law.S / law.K;
   const double dnp = std::max(dn, 0.0);
   const double dm = std::sqrt(dnp * dnp + ds * ds);
-  double dm0 = ds0, dmf = 2 * law.GIIc / (law.K * ds0);
-  if (dnp > 0) {
-    const double b = ds / dnp;
-    dm0 = dn0 * ds0 * std::sqrt((1 + b * b) / (ds0 * ds0 + b * b * dn0 * dn0));
-    const double B = ds * ds / (dnp * dnp + ds * ds);
-    const double Gc = law.GIc + (law.GIIc - law.GIc) * std::pow(B, law.eta);
-    dmf = 2 * Gc / (law.K * dm0);
-  }
+  // The damage moves only past the largest separation so far and past initiation; dm0 lies
+  // between dn0 and ds0 (1 / dm0^2 is a weighted mean of 1 / dn0^2 and 1 / ds0^2), so below the
+  // smaller of the two the mixed-mode measures (a pow: most of a tie's cycle in a crush) are not
+  // made. The same state (but where dm0, rounded, falls under that bound: damage of a rounding).
   if (dm > st.max_separation) {
     st.max_separation = dm;
-    if (dm > dm0) {
-      const double d = dmf * (dm - dm0) / (dm * std::max(dmf - dm0, 1e-300));
-      st.damage = std::clamp(std::max(st.damage, d), 0.0, 1.0);
+    const double dn0 = law.N / law.K, ds0 = law.S / law.K;
+    if (dm > std::min(dn0, ds0)) {
+      double dm0 = ds0, dmf = 2 * law.GIIc / (law.K * ds0);
+      if (dnp > 0) {
+        const double b = ds / dnp;
+        dm0 = dn0 * ds0 * std::sqrt((1 + b * b) / (ds0 * ds0 + b * b * dn0 * dn0));
+        const double B = ds * ds / (dnp * dnp + ds * ds);
+        const double Gc = law.GIc + (law.GIIc - law.GIc) * std::pow(B, law.eta);
+        dmf = 2 * Gc / (law.K * dm0);
+      }
+      if (dm > dm0) {
+        const double d = dmf * (dm - dm0) / (dm * std::max(dmf - dm0, 1e-300));
+        st.damage = std::clamp(std::max(st.damage, d), 0.0, 1.0);
+      }
     }
   }
   const double keep = 1 - st.damage;

@@ -187,8 +187,15 @@ TEST(CohesiveTie, EndNotchedFlexureGivesModeIIEnergy) {
       P.push_back(-solver.reaction_force(nose.nodes).z);
       delta.push_back(z0 - X[3 * static_cast<std::size_t>(nose.nodes[0]) + 2]);
     });
-  const std::size_t peak =
-      static_cast<std::size_t>(std::max_element(P.begin(), P.end()) - P.begin());
+  // The peak at the crack's start: from the first load within 10 % of the largest, the largest
+  // before the load falls 5 % below it. (Once the crack has run past the nose the beam stiffens
+  // again and the load can climb back over it by the end: 0.7 % in one run, after a change of
+  // rounding in the ties.)
+  const double P_max = *std::max_element(P.begin(), P.end());
+  std::size_t peak = 0;
+  while (P[peak] < 0.9 * P_max) ++peak;
+  for (std::size_t k = peak; k < P.size() && P[k] >= 0.95 * P[peak]; ++k)
+    if (P[k] > P[peak]) peak = k;
   // Initial compliance: least squares through the origin over 20-50 % of the peak load (past the
   // start-up ramp).
   double spp = 0, spd = 0;
