@@ -37,6 +37,13 @@ struct ToolMesh {
 };
 ToolMesh tool_mesh(const ExportTool& t);
 
+/// The directions (x, y, z) a rigid tool is held in: those it does not move along. LS-DYNA's
+/// prescribed motion and OpenRadioss's IMPVEL read a zero scale as 1, so a direction at rest is
+/// held (CON1, BCS) rather than given a zero velocity.
+inline std::array<bool, 3> held_directions(const ExportTool& t) {
+  return {t.velocity[0] == 0, t.velocity[1] == 0, t.velocity[2] == 0};
+}
+
 /// The smooth ramp of a tool's velocity (cubic, as the engine's smooth_ramp) as (time, factor)
 /// points to the end time.
 std::vector<std::array<double, 2>> ramp_curve(double ramp_time, double end_time);

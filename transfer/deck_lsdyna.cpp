@@ -231,9 +231,10 @@ struct LsDynaDeck {
            ints({static_cast<long long>(pid), 3, static_cast<long long>(mid)});
       s += "*MAT_RIGID\n$      MID        RO         E        PR\n" + fmt::format("{:>10}", mid) +
            field(7850) + field(2.1e11) + field(0.3) + "\n";
-      // CON1: the translations at rest held (a zero SF reads as 1, so a direction at rest gets no
-      // prescribed motion: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all).
-      const bool rx = tool.velocity[0] == 0, ry = tool.velocity[1] == 0, rz = tool.velocity[2] == 0;
+      // CON1: the translations at rest held (held_directions: 1 x, 2 y, 3 z, 4 x and y, 5 y and
+      // z, 6 z and x, 7 all).
+      const auto held = deck::held_directions(tool);
+      const bool rx = held[0], ry = held[1], rz = held[2];
       const double con1 = rx && ry && rz ? 7
                           : rx && ry     ? 4
                           : ry && rz     ? 5
@@ -252,7 +253,7 @@ struct LsDynaDeck {
             first + static_cast<std::size_t>(q[2]), first + static_cast<std::size_t>(q[3]));
       if (!moving) continue;
       for (int d = 0; d < 3; ++d) {
-        if (tool.velocity[static_cast<std::size_t>(d)] == 0) continue;
+        if (held[static_cast<std::size_t>(d)]) continue;
         s += "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n$      PID       DOF       VAD      LCID        "
              "SF\n";
         s += ints({static_cast<long long>(pid), d + 1, 0, 1}).substr(0, 40) +

@@ -170,16 +170,16 @@ struct RadiossDeck {
            I(static_cast<long long>(tool_main_node[t])) + I(0) + I(0) + I(0) + F(0) + I(group) +
            I(0) + I(0) + I(0) + "\n" + F(0) + F(0) + F(0) + "\n" + F(0) + F(0) + F(0) + "\n" +
            I(0) + I(0) + I(0) + "\n";
-      // Held in every direction it does not move along (IMPVEL takes a zero scale for 1, so a
-      // direction at rest is fixed by the BCS instead), and in rotation.
-      std::string held = "   ";
-      for (int d = 0; d < 3; ++d)
-        held += tool.velocity[static_cast<std::size_t>(d)] == 0 ? '1' : '0';
-      s += fmt::format("/BCS/{}\n{}_held\n", t + 1, tool.name) + held + " 111" + I(0) + I(main) +
+      // Held in every direction it does not move along (held_directions: the BCS), and in
+      // rotation.
+      const auto held = deck::held_directions(tool);
+      std::string flags = "   ";
+      for (int d = 0; d < 3; ++d) flags += held[static_cast<std::size_t>(d)] ? '1' : '0';
+      s += fmt::format("/BCS/{}\n{}_held\n", t + 1, tool.name) + flags + " 111" + I(0) + I(main) +
            "\n";
       for (int d = 0; d < 3; ++d) {
+        if (held[static_cast<std::size_t>(d)]) continue;
         const double v = tool.velocity[static_cast<std::size_t>(d)];
-        if (v == 0) continue;
         s += fmt::format("/IMPVEL/{}\n{}_{}\n", 10 * (t + 1) + static_cast<std::size_t>(d),
                          tool.name, "XYZ"[d]) +
              I(1) + fmt::format("{:>10}", "XYZ"[d]) + I(0) + I(0) + I(main) + I(0) + I(0) + "\n" +
