@@ -25,6 +25,11 @@ std::string F(double v) { return fmt::format("{:>20.10g}", v); }
 constexpr int kToolMaterial = 9001, kToolProperty = 9001, kTowProperty = 1;
 constexpr int kAllTowNodes = 1;   // /GRNOD: every tow node (secondary of the tools' contacts)
 constexpr int kTowSurface = 399;  // /SURF/PART/EXT: the tows' outer faces
+// Ids of the cards made per tool t and per tie set i: base + t (or + i).
+constexpr long long kToolNodes = 100;    // /GRNOD: the tool's facet nodes (its rigid body)
+constexpr long long kToolMain = 200;     // /GRNOD: its main node (BCS, IMPVEL)
+constexpr long long kToolSurface = 300;  // /SURF/SEG: its facets
+constexpr long long kTieSecondary = 400, kTieMain = 500;  // a tie set's node group and surface
 
 struct RadiossDeck {
   const ExportModel& m;
@@ -158,8 +163,8 @@ struct RadiossDeck {
       }
       if (!quads.empty()) s += fmt::format("/SHELL/{}\n", pid) + quads;
       if (!triangles.empty()) s += fmt::format("/SH3N/{}\n", pid) + triangles;
-      const long long group = 100 + static_cast<long long>(t),
-                      main = 200 + static_cast<long long>(t);
+      const long long group = kToolNodes + static_cast<long long>(t),
+                      main = kToolMain + static_cast<long long>(t);
       s += fmt::format("/GRNOD/NODE/{}\n{}_nodes\n", group, tool.name);
       for (std::size_t k = 0; k < tools[t].nodes.size(); ++k)
         s += I(static_cast<long long>(tool_first_node[t] + k + 1)) +
@@ -225,22 +230,22 @@ struct RadiossDeck {
     for (std::size_t p = 0; p < parts.size(); ++p)
       s += I(static_cast<long long>(p + 1)) + (p % 10 == 9 || p + 1 == parts.size() ? "\n" : "");
     for (std::size_t t = 0; t < tools.size(); ++t) {
-      const long long surf = 300 + static_cast<long long>(t);
+      const long long surf = kToolSurface + static_cast<long long>(t);
       tool_surface(t, surf);
       const auto& tool = cr.tools[t];
       type7(static_cast<long long>(t + 1), tool.name + "_on_tows", kAllTowNodes, surf,
             tool.friction);
       if (tool.sphere)
         type7(static_cast<long long>(tools.size() + t + 1), "tows_on_" + tool.name,
-              100 + static_cast<long long>(t), kTowSurface, tool.friction);
+              kToolNodes + static_cast<long long>(t), kTowSurface, tool.friction);
     }
   }
 
   // Resin bonds: TYPE2 penalty ties (Spotflag 25, a tenth of the default stiffness), which do not
-  // fail. Its ties with rupture
-  // (Spotflag 20-22) are kinematic, and the starter refuses a kinematic tie whose main node is
-  // another's secondary (error 556): the dome's bonds form such chains (a tow is main to one
-  // neighbour and secondary to the next, and the plies cross each other's tows).
+  // fail. Its ties with rupture (Spotflag 20-22) are kinematic, and the starter refuses a
+  // kinematic tie whose main node is another's secondary (error 556): the dome's bonds form such
+  // chains (a tow is main to one neighbour and secondary to the next, and the plies cross each
+  // other's tows).
   void resin_bonds() {
     for (std::size_t i = 0; i < m.ties.size(); ++i) {
       const auto& t = m.ties[i];
@@ -248,8 +253,8 @@ struct RadiossDeck {
       for (auto [e, f] : t.slave)
         for (int a = 0; a < 4; ++a)
           secondary.insert(m.hex[static_cast<std::size_t>(e)][kFace[f].corner[a]]);
-      const long long group = 400 + static_cast<long long>(i),
-                      surf = 500 + static_cast<long long>(i);
+      const long long group = kTieSecondary + static_cast<long long>(i),
+                      surf = kTieMain + static_cast<long long>(i);
       s += fmt::format("/GRNOD/NODE/{}\n{}_secondary\n", group, t.name);
       std::size_t k = 0;
       for (auto n : secondary) s += I(n + 1) + (++k % 10 == 0 || k == secondary.size() ? "\n" : "");
