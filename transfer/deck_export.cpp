@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -235,8 +236,13 @@ DeckContents deck_contents(const ExportModel& m, const std::string& format) {
         "the tows' per-mode failure: /MAT/LAW123 (Daimler-Pinho: strengths, fracture energies of "
         "fibre tension, kinking, matrix tension, transverse and longitudinal shear, regularised by "
         "V^(1/3)), each brick's axes in /INIBRI/ORTHO");
+    std::size_t points = 0;
+    for (const auto& t : m.ties) points += t.points.size();
     d.carried.push_back(fmt::format(
-        "{} resin-bond interfaces as /INTER/TYPE2 penalty ties (Spotflag 25)", m.ties.size()));
+        "{} resin-bond interfaces as the crush ties them: {} tied nodes, each a /PROP/TYPE8 spring "
+        "of its tie's stiffness to an /RBE3 point of its master face, failing on the bond's "
+        "smaller strength times its area",
+        m.ties.size(), points));
     d.carried.push_back(fmt::format(
         "{} rigid tools (shell facets on /RBODY), the punch's ramped velocity (/IMPVEL), tows on "
         "tools /INTER/TYPE7 with friction",
@@ -252,10 +258,9 @@ DeckContents deck_contents(const ExportModel& m, const std::string& format) {
         "one), the residual compressive strength, erode_on (LAW123 erodes a "
         "brick when a mode's damage is complete)");
     d.left_out.push_back(
-        "the bonds' failure: OpenRadioss's ties with rupture are kinematic, and its starter "
-        "refuses "
-        "the chains of ties a +-45 fabric has (a tow main to one neighbour, secondary to the next; "
-        "its error 556)");
+        "the bonds' softening (mode I / II energies, B-K mixed mode): a spring fails at once when "
+        "its force reaches the bond's smaller strength, in any direction; the tie's offset turns "
+        "with its face in ncfsim, not in the spring");
     return d;
   }
   if (format == "lsdyna") {
@@ -398,6 +403,7 @@ DeckCounts read_radioss_deck(const std::filesystem::path& file) {
   if (!in) throw std::runtime_error(file.string() + ": cannot be read");
   DeckCounts c;
   std::string line, block;
+  std::set<std::string> bond_sets, failing_props;
   int line_in_block = 0;
   auto reals = [&](const std::string& l) {
     std::vector<double> v;
@@ -412,13 +418,20 @@ DeckCounts read_radioss_deck(const std::filesystem::path& file) {
       const auto starts = [&](const char* key) { return line.rfind(key, 0) == 0; };
       if (starts("/MAT/LAW123/")) ++c.materials, ++c.failure_materials;
       if (starts("/RBODY/")) ++c.rigid_parts;  // a tool each
-      if (starts("/INTER/TYPE2/")) ++c.ties, ++c.softening_ties;
+      if (starts("/RBE3/")) ++c.tie_points;
       if (starts("/INTER/TYPE7/")) ++c.contacts;
       if (starts("/IMPVEL/")) ++c.motions;
       continue;
     }
     ++line_in_block;
-    if (block == "/NODE") {
+    if (block.rfind("/PROP/TYPE8/", 0) == 0 && line_in_block == 1) {  // "<interface>_bond_k.."
+      const auto at = line.find("_bond_");
+      if (at != std::string::npos) bond_sets.insert(line.substr(0, at));
+    } else if (block.rfind("/PROP/TYPE8/", 0) == 0 && line_in_block == 2) {
+      if (line.size() >= 90 && std::stoi(line.substr(70, 10)) == 1 &&
+          std::stoi(line.substr(80, 10)) == 1)
+        failing_props.insert(block);  // Ifail 1, Ifail2 1: multi-directional, on force
+    } else if (block == "/NODE") {
       ++c.nodes;
     } else if (block.rfind("/BRICK/", 0) == 0) {
       ++c.elements;
@@ -439,6 +452,8 @@ DeckCounts read_radioss_deck(const std::filesystem::path& file) {
       }
     }
   }
+  c.ties = bond_sets.size();
+  c.softening_ties = failing_props.empty() ? 0 : c.ties;
   auto engine = file;
   engine.replace_filename(file.stem().string().substr(0, file.stem().string().size() - 5) +
                           "_0001.rad");

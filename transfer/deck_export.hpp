@@ -25,11 +25,25 @@ struct ExportMaterial {
   fem::OrthotropicConstants elastic{};
 };
 
+/// One slave node of a tied interface as the crush ties it: held at the point sum_a N_a x_a of a
+/// master face by a penalty spring of stiffness k in every direction; it fails on its bond's
+/// strength times its tributary area.
+struct ExportTiePoint {
+  std::int32_t node = 0;                 // 0-based
+  std::array<std::int32_t, 4> corner{};  // the master face's corners, 0-based
+  std::array<double, 4> weight{};        // N_a at the tied point
+  double stiffness = 0;                  // N/m
+  double area = 0;                       // m^2
+};
+
 /// A tied interface: faces (element index, face 0..5 in VTK-hexahedron face order: -z, +z, -y,
 /// +x, +y, -x of the reference cube) of the slave and master sides.
 struct ExportTie {
   std::string name;
   std::vector<std::pair<std::int32_t, int>> slave, master;
+  /// The crush's own ties (a crush case's export; fem/contact/tied_contact.hpp): a deck whose
+  /// solver has no tie like ncfsim's builds them from these (OpenRadioss: a spring per point).
+  std::vector<ExportTiePoint> points;
 };
 
 /// Kept stitches: tension-only yarn bars between model nodes (Abaqus T3D2 with *NO COMPRESSION,
@@ -87,6 +101,7 @@ struct ExportCrush {
   double history_interval = 0;    // s, force and energies
   double frame_interval = 0;      // s, field output
   double safety_factor = 0.9;     // of the stable step
+  double first_step = 0;          // s, ncfsim's first step (its ties' stiffness is set by it)
   double erosion_step_ratio = 0;  // 0: none; else a hexahedron whose step falls below
                                   // this share of the first is eroded
   /// Elements whose fracture energy ncfsim raises to their crack band, per mode (the deck's
@@ -127,9 +142,11 @@ std::vector<std::filesystem::path> write_radioss_deck(const std::filesystem::pat
 struct DeckCounts {
   std::size_t nodes = 0, elements = 0, orientations = 0, materials = 0, ties = 0;
   std::size_t bars = 0;  // stitch elements (counted in elements too)
-  // The crush's cards: per-mode failure materials, softening bonds, rigid tool parts and their
-  // shell elements, prescribed motions, plies' contacts, the end time (0: none).
+  // The crush's cards: per-mode failure materials, bonds that soften (LS-DYNA) or fail (Radioss),
+  // rigid tool parts and their shell elements, prescribed motions, plies' contacts, the end time
+  // (0: none).
   std::size_t failure_materials = 0, softening_ties = 0, rigid_parts = 0, tool_elements = 0;
+  std::size_t tie_points = 0;  // Radioss: the ties' /RBE3 points (a spring each)
   std::size_t motions = 0, contacts = 0;
   double end_time = 0;
   std::vector<std::array<double, 6>>

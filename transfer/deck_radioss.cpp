@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
+#include <tuple>
 
 #include "fem/elements/element_kind.hpp"
 #include "fem/io/atomic_file.hpp"
@@ -29,7 +31,10 @@ constexpr int kTowSurface = 399;  // /SURF/PART/EXT: the tows' outer faces
 constexpr long long kToolNodes = 100;    // /GRNOD: the tool's facet nodes (its rigid body)
 constexpr long long kToolMain = 200;     // /GRNOD: its main node (BCS, IMPVEL)
 constexpr long long kToolSurface = 300;  // /SURF/SEG: its facets
-constexpr long long kTieSecondary = 400, kTieMain = 500;  // a tie set's node group and surface
+// Resin bonds: /GRNOD of one corner node each (base + node id), spring properties from base + 1.
+constexpr long long kCornerGroup = 1000000, kBondProperty = 10000;
+constexpr double kClassRatio = 1.02;   // spring classes: stiffness and failure force ratio
+constexpr double kLeastWeight = 1e-4;  // an /RBE3 corner's smallest weight
 
 struct RadiossDeck {
   const ExportModel& m;
@@ -241,37 +246,105 @@ struct RadiossDeck {
     }
   }
 
-  // Resin bonds: TYPE2 penalty ties (Spotflag 25, a tenth of the default stiffness), which do not
-  // fail. Its ties with rupture (Spotflag 20-22) are kinematic, and the starter refuses a
-  // kinematic tie whose main node is another's secondary (error 556): the dome's bonds form such
-  // chains (a tow is main to one neighbour and secondary to the next, and the plies cross each
-  // other's tows).
+  // Resin bonds, each of the crush's ties as it is: its point on the master face an /RBE3 node
+  // (weights N_a, translations) and a /PROP/TYPE8 spring of the tie's stiffness in x, y and z
+  // from the slave node to it, failing where the force reaches the bond's smaller strength times
+  // the tie's area (multi-directional on force: |F| = cap). OpenRadioss's own ties do not serve:
+  // those with rupture are kinematic and refuse the chains a +-45 fabric has (error 556), the
+  // penalty ones (TYPE2 Spotflag 25) are 37 times softer than ncfsim's at Stfac 0.1 and drop
+  // every secondary projecting beyond 1.5 of its face (docs/export.md). Springs share a property
+  // per class of stiffness and failure force (ratio kClassRatio, within 1 % of each tie's).
   void resin_bonds() {
+    if (m.ties.empty()) return;
+    if (!(cr.first_step > 0))
+      throw std::invalid_argument("export: the Radioss deck's ties need the crush's first step");
+    struct Spring {
+      std::size_t tie, point;
+      long long p;  // the /RBE3 node
+    };
+    std::vector<Spring> springs;
+    double k_min = 1e300, cap_min = 1e300;
+    const auto cap = [&](std::size_t i, const ExportTiePoint& q) {
+      const auto& b = cr.bonds[i];
+      return std::min(b.normal_strength, b.shear_strength) * q.area;
+    };
+    s += "/NODE\n";
     for (std::size_t i = 0; i < m.ties.size(); ++i) {
-      const auto& t = m.ties[i];
-      std::set<std::int32_t> secondary;
-      for (auto [e, f] : t.slave)
-        for (int a = 0; a < 4; ++a)
-          secondary.insert(m.hex[static_cast<std::size_t>(e)][kFace[f].corner[a]]);
-      const long long group = kTieSecondary + static_cast<long long>(i),
-                      surf = kTieMain + static_cast<long long>(i);
-      s += fmt::format("/GRNOD/NODE/{}\n{}_secondary\n", group, t.name);
-      std::size_t k = 0;
-      for (auto n : secondary) s += I(n + 1) + (++k % 10 == 0 || k == secondary.size() ? "\n" : "");
-      s += fmt::format("/SURF/SEG/{}\n{}_main\n", surf, t.name);
-      long long seg = 0;
-      for (auto [e, f] : t.master) {
-        s += I(++seg);
-        for (int a = 0; a < 4; ++a)
-          s += I(m.hex[static_cast<std::size_t>(e)][kFace[f].corner[a]] + 1);
-        s += "\n";
+      if (m.ties[i].points.empty())
+        throw std::invalid_argument("export: tie '" + m.ties[i].name +
+                                    "' has no tied points (the crush's ties) for the Radioss deck");
+      for (std::size_t j = 0; j < m.ties[i].points.size(); ++j) {
+        const auto& q = m.ties[i].points[j];
+        const auto w = weights(q);
+        std::array<double, 3> x{};
+        for (std::size_t a = 0; a < 4; ++a)
+          for (std::size_t k = 0; k < 3; ++k)
+            x[k] += w[a] * m.nodes[static_cast<std::size_t>(q.corner[a])][k];
+        springs.push_back({i, j, static_cast<long long>(++next_node)});
+        s += I(springs.back().p) + F(x[0]) + F(x[1]) + F(x[2]) + "\n";
+        k_min = std::min(k_min, q.stiffness), cap_min = std::min(cap_min, cap(i, q));
       }
-      s += fmt::format("/INTER/TYPE2/{}\n{}\n", 100 + i, t.name);
-      s += I(group) + I(surf) + I(0) + I(25) + I(0) + I(0) + I(0) + I(0) + F(0) + "\n";
-      // Stfac 0.1: at the default stiffness the ties set the step and blew the CI dome's crush
-      // up some 20 us after the punch touched it.
-      s += F(0.1) + F(0) + std::string(20, ' ') + I(0) + "\n";
     }
+    std::set<std::int32_t> corners;
+    for (const auto& t : m.ties)
+      for (const auto& q : t.points) corners.insert(q.corner.begin(), q.corner.end());
+    for (auto n : corners)
+      s += fmt::format("/GRNOD/NODE/{}\nbond_corner\n", kCornerGroup + n + 1) + I(n + 1) + "\n";
+    long long rbe3 = 0;
+    for (const auto& sp : springs) {
+      const auto& q = m.ties[sp.tie].points[sp.point];
+      const auto w = weights(q);
+      s += fmt::format("/RBE3/{}\n{}_{}\n", ++rbe3, m.ties[sp.tie].name, q.node + 1) + I(sp.p) +
+           "   111 000" + I(4) + I(0) + "\n";
+      for (std::size_t a = 0; a < 4; ++a)
+        s += F(w[a]) + "   111 000" + I(0) + I(kCornerGroup + q.corner[a] + 1) + "\n";
+    }
+    // Classes: log bins of stiffness and failure force, each at its bin's geometric centre.
+    const auto bin = [](double v, double lo) {
+      return static_cast<int>(std::floor(std::log(v / lo) / std::log(kClassRatio)));
+    };
+    const auto centre = [](int b, double lo) { return lo * std::pow(kClassRatio, b + 0.5); };
+    std::map<std::tuple<std::size_t, int, int>, std::vector<std::size_t>> classes;
+    for (std::size_t n = 0; n < springs.size(); ++n) {
+      const auto& q = m.ties[springs[n].tie].points[springs[n].point];
+      classes[{springs[n].tie, bin(q.stiffness, k_min), bin(cap(springs[n].tie, q), cap_min)}]
+          .push_back(n);
+    }
+    // A spring's step in OpenRadioss is 0.9 sqrt(m / k): its mass gives it the crush's first step
+    // (the bricks set a smaller one there), a few per cent of the tows' mass.
+    const double mass_per_stiffness = std::pow(cr.first_step / 0.9, 2);
+    long long pid = kBondProperty, part = static_cast<long long>(parts.size() + tools.size());
+    for (const auto& [key, members] : classes) {
+      const auto& [tie, kb, cb] = key;
+      const double k = centre(kb, k_min), f = centre(cb, cap_min), mass = k * mass_per_stiffness;
+      const std::string title = fmt::format("{}_bond_k{}_f{}", m.ties[tie].name, kb, cb);
+      ++pid, ++part;
+      s += fmt::format("/PROP/TYPE8/{}\n{}\n", pid, title) + F(mass) + F(mass * 1e-8) + I(0) +
+           I(0) + I(0) + I(1) + I(1) + I(0) + "\n";
+      for (int dof = 0; dof < 6; ++dof) {
+        const bool translation = dof < 3;
+        s += F(translation ? k : 0) + F(0) + F(1) + F(0) + F(0) + "\n";
+        s += I(0) + I(0) + I(0) + I(0) + I(0) + std::string(10, ' ') + F(translation ? -f : 0) +
+             F(translation ? f : 0) + "\n";
+        s += F(0) + F(0) + F(0) + F(0) + "\n";
+      }
+      s += I(0) + F(0) + "\n";
+      s += fmt::format("/PART/{}\n{}\n", part, title) + I(pid) + I(0) + I(0) + F(0) + "\n";
+      s += fmt::format("/SPRING/{}\n", part);
+      for (auto n : members)
+        s += I(static_cast<long long>(++next_elem)) +
+             I(m.ties[tie].points[springs[n].point].node + 1) + I(springs[n].p) + "\n";
+    }
+  }
+
+  // An /RBE3's weights: N_a, with a floor (its starter reads a zero weight as 1 and needs three
+  // independent nodes), normalised.
+  static std::array<double, 4> weights(const ExportTiePoint& q) {
+    std::array<double, 4> w{};
+    double sum = 0;
+    for (std::size_t a = 0; a < 4; ++a) sum += w[a] = std::max(q.weight[a], kLeastWeight);
+    for (auto& x : w) x /= sum;
+    return w;
   }
 
   // The punch's rigid body (its force), the contacts, the parts' energies.

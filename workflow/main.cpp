@@ -294,6 +294,7 @@ int run_export(const FolderArgs& a) {
   const std::string& folder = a.folder;
   const std::string& deck_format = a.deck_format;
   if (std::filesystem::is_regular_file(folder)) {  // a crush case
+    ncfsim::fem::PetscSession petsc;  // the Radioss deck's ties are the crush solver's own
     const auto r = wf::export_crush_case(folder, a.export_overrides, deck_format, a.export_output);
     std::printf("%s: %zu nodes, %zu elements, %zu materials, %zu tie faces, %zu stitch bars\n",
                 r.result.file.c_str(), r.result.nodes, r.result.elements, r.result.materials,
@@ -543,6 +544,7 @@ void add_compare(CLI::App& app, CompareArgs& a) {
 struct CrushCompareArgs {
   CLI::App* cmd = nullptr;
   wf::CrushCompareOptions cmp;
+  double slope_window_mm = 0;
 };
 
 void add_compare_crush(CLI::App& app, CrushCompareArgs& a) {
@@ -558,6 +560,11 @@ void add_compare_crush(CLI::App& app, CrushCompareArgs& a) {
   a.cmd->add_option("-o,--output", a.cmp.out_dir, "Output folder (default crush_comparison)");
   a.cmd->add_option("--cfc", a.cmp.cfc,
                     "SAE J211 class of the filtered force (default 600; 0: raw)");
+  a.cmd
+      ->add_option("--slope-window", a.slope_window_mm,
+                   "Stroke after each curve's contact over which the elastic slope is fitted, "
+                   "mm (default: the shortest first loading, contact to first peak, of all)")
+      ->check(CLI::Range(0.0, 100.0));
   a.cmd->add_flag("--overwrite", a.cmp.overwrite,
                   "Write into a folder that holds files ncfsim did not write");
 }
@@ -621,6 +628,7 @@ int main(int argc, char** argv) {
     if (*compare.cmd) return run_compare(compare, verbosity);
     if (*compare_crush.cmd) {
       compare_crush.cmp.verbosity = verbosity;
+      compare_crush.cmp.slope_window = 1e-3 * compare_crush.slope_window_mm;
       return wf::compare_crushes(compare_crush.cmp);
     }
     if (*stitch.cmd) return run_calibrate_stitch(stitch);

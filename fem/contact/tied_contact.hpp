@@ -5,6 +5,7 @@
 // (m_s + m_m) / dt0^2 in all directions. A tie fails on the quadratic criterion of
 // TiedContactConfig; a failed tie's elastic energy is counted as dissipated
 // (friction_dissipation()) and it carries no force afterwards.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -60,6 +61,20 @@ class TiedContact final : public ContactAlgorithm {
   }
   /// Slave nodes beside no master segment (within the search distance): not tied.
   std::size_t untied_nodes() const { return untied_; }
+
+  /// One tie as initialise() made it, for a deck that ties the same points (transfer's export).
+  struct TieRecord {
+    std::int32_t node = 0;                 // slave node
+    std::array<std::int32_t, 4> corner{};  // master segment's corners
+    double xi = 0, eta = 0;                // the tied point on the segment
+    double stiffness = 0;                  // k, N/m
+    double area = 0;                       // tributary area, m^2
+  };
+  TieRecord tie(std::size_t t) const {
+    TieRecord r{node_[t], {}, xi_[t], eta_[t], stiffness_[t], area_[t]};
+    for (std::size_t a = 0; a < 4; ++a) r.corner[a] = corner_[4 * t + a];
+    return r;
+  }
 
  private:
   /// Every tie intact, no work done yet (after the ties are found).

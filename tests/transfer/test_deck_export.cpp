@@ -31,7 +31,7 @@ transfer::ExportModel two_tows() {
   m.materials = {
       {"tow_vf0600", 1548, {139e9, 8.5e9, 8.5e9, 0.26, 0.26, 0.36, 4.8e9, 4.8e9, 3.1e9}},
       {"tow_vf0650", 1580, {150e9, 9.5e9, 9.5e9, 0.25, 0.25, 0.35, 5.2e9, 5.2e9, 3.4e9}}};
-  m.ties.push_back({"tow_tow", {{0, 3}}, {{1, 5}}});
+  m.ties.push_back({"tow_tow", {{0, 3}}, {{1, 5}}, {}});
   return m;
 }
 
@@ -78,6 +78,10 @@ transfer::ExportModel two_tows_crushed() {
                          0.2,
                          {true, true, false, false, false, false}});
   c.bonds.push_back({40e6, 60e6, 300, 1000, 1.45});
+  c.first_step = 1.8e-8;
+  // Two tied nodes as the crush would tie them (a Radioss deck writes a spring each).
+  m.ties[0].points = {{1, {1, 4, 10, 7}, {0.5, 0.5, 0, 0}, 2e8, 0.25e-6},
+                      {4, {1, 4, 10, 7}, {0, 1, 0, 0}, 3e8, 0.5e-6}};
   transfer::ExportTool punch;
   punch.name = "punch";
   punch.sphere = true;
@@ -169,11 +173,13 @@ TEST(DeckExport, RadiossDeckCarriesLawAxesTiesToolsMotionAndEndTime) {
     const auto mesh = transfer::deck::tool_mesh(t);
     tool_nodes += mesh.nodes.size() + 1, tool_facets += mesh.quads.size();  // + the main node
   }
-  EXPECT_EQ(c.nodes, 12u + tool_nodes);
+  EXPECT_EQ(c.nodes, 12u + tool_nodes + 2u);  // + an /RBE3 point per tied node
   EXPECT_EQ(c.elements, 2u);
   EXPECT_EQ(c.materials, 2u);  // LAW123 per class
   EXPECT_EQ(c.failure_materials, 2u);
-  EXPECT_EQ(c.ties, 1u);         // TYPE2
+  EXPECT_EQ(c.ties, 1u);  // one interface
+  EXPECT_EQ(c.softening_ties, 1u);
+  EXPECT_EQ(c.tie_points, 2u);
   EXPECT_EQ(c.rigid_parts, 2u);  // RBODY
   EXPECT_EQ(c.tool_elements, tool_facets);
   EXPECT_EQ(c.motions, 1u);   // IMPVEL along the motion; the rest held (BCS)
@@ -191,7 +197,20 @@ TEST(DeckExport, RadiossDeckCarriesLawAxesTiesToolsMotionAndEndTime) {
       deck.find("               80000               90000                 280                 "
                 "500                 800"),
       std::string::npos);
-  EXPECT_NE(deck.find("# left out: the bonds' failure"), std::string::npos);
+  EXPECT_NE(deck.find("# left out: the bonds' softening"), std::string::npos);
+  // The second tie's spring: k within 1 % (its class's centre), failing at 40 MPa x 0.5 mm^2 =
+  // 20 N (to its class's 1 %), its mass k (dt / 0.9)^2.
+  const auto at = deck.find("/PROP/TYPE8/10002\ntow_tow_bond_");
+  ASSERT_NE(at, std::string::npos) << deck;
+  std::istringstream card(deck.substr(deck.find('\n', deck.find('\n', at) + 1) + 1));
+  std::string mass_line, k_line, fail_line;
+  std::getline(card, mass_line), std::getline(card, k_line), std::getline(card, fail_line);
+  const double k = std::stod(k_line.substr(0, 20));
+  EXPECT_NEAR(k, 3e8, 0.01 * 3e8);
+  EXPECT_NEAR(std::stod(mass_line.substr(0, 20)), k * std::pow(1.8e-8 / 0.9, 2), 1e-9 * k);
+  EXPECT_EQ(mass_line.substr(70, 20), "         1         1");  // Ifail, Ifail2: |F| on force
+  EXPECT_NEAR(std::stod(fail_line.substr(60, 20)), -20.0, 0.2);
+  EXPECT_NEAR(std::stod(fail_line.substr(80, 20)), 20.0, 0.2);
   // The punch held in x, y and rotation (its z driven), the support in everything.
   EXPECT_NE(deck.find("   110 111"), std::string::npos);
   EXPECT_NE(deck.find("   111 111"), std::string::npos);

@@ -194,6 +194,8 @@ TEST(CliCrush, CaseExportsAsDecksThatReadBackAgainstTheTransfer) {
   EXPECT_EQ(rad.orientations, n_hex);
   EXPECT_EQ(rad.failure_materials, n_class);
   EXPECT_EQ(rad.ties, n_interface);
+  EXPECT_EQ(rad.softening_ties, n_interface);  // springs failing on the bonds' strengths
+  EXPECT_GT(rad.tie_points, 0u);
   EXPECT_EQ(rad.motions, 1u);
   EXPECT_DOUBLE_EQ(rad.end_time, 1.5e-4);
   // Not a crush: refused, naming the kind.
@@ -242,6 +244,48 @@ TEST(CliCrush, CompareCrushMeasuresSlopePeakAndEnergyOfEachCurve) {
   // A source that is neither: refused, naming it.
   const auto bad = run_cli({"compare-crush", (f.dir / "nothing").string(), "-o", out.string()});
   EXPECT_EQ(bad.code, 2) << bad.output;
+}
+
+// The elastic slope is the first loading's, each curve from its own contact: two curves that
+// touch 0.15 mm apart, rise at 1 500 N/mm to a first peak 0.2 mm after contact and then fail
+// differently read the same slope (to the least-squares line's exactness on a straight rise), the
+// window the shorter first loading, and an explicit --slope-window is taken as given.
+TEST(CliCrush, CompareCrushTakesTheSlopeOverTheFirstLoadingFromEachContact) {
+  Fixture f;
+  const double k = 1.5e6, ds = 2.5e-5, v = 1.5;  // N/m, m per sample, m/s
+  auto write_curve = [&](const fs::path& file, double contact, double after_peak) {
+    std::ofstream o(file);
+    o << std::setprecision(17) << "time_s,stroke_m,force_N\n";
+    for (int i = 0; i <= 120; ++i) {
+      const double s = i * ds, x = s - contact;
+      const double force = x <= 0 ? 0 : x <= 2e-4 + 1e-12 ? k * x : after_peak;
+      o << s / v << "," << s << "," << force << "\n";
+    }
+  };
+  write_curve(f.dir / "a.csv", 4e-4, 150);  // fails to half its first peak
+  write_curve(f.dir / "b.csv", 5.5e-4, 90);
+  const fs::path out = f.dir / "cmp_loading";
+  const auto r = run_cli({"compare-crush", "a=" + (f.dir / "a.csv").string(),
+                          "b=" + (f.dir / "b.csv").string(), "-o", out.string()});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto js = nlohmann::json::parse(slurp(out / "summary.json"));
+  SCOPED_TRACE(js.dump(1));
+  EXPECT_NEAR(js["slope_window_m"].get<double>(), 2e-4, 1e-9);
+  const double contact[2] = {4e-4, 5.5e-4};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto& x = js["sources"][i];
+    EXPECT_NEAR(x["elastic_slope_N_per_m"].get<double>(), k, 1e-6 * k);
+    EXPECT_NEAR(x["contact_stroke_m"].get<double>(), contact[i], 1e-9);
+    EXPECT_NEAR(x["first_peak_force_N"].get<double>(), 300, 1e-6);
+    EXPECT_NEAR(x["first_peak_stroke_m"].get<double>(), contact[i] + 2e-4, 1e-9);
+  }
+  // A window past the first peak takes in the failure: the slope falls, as given.
+  const auto r2 = run_cli({"compare-crush", "a=" + (f.dir / "a.csv").string(), "-o",
+                           (out / "wide").string(), "--slope-window", "0.4"});
+  ASSERT_EQ(r2.code, 0) << r2.output;
+  const auto wide = nlohmann::json::parse(slurp(out / "wide" / "summary.json"));
+  EXPECT_NEAR(wide["slope_window_m"].get<double>(), 4e-4, 1e-12);
+  EXPECT_LT(wide["sources"][0]["elastic_slope_N_per_m"].get<double>(), 0.8 * k);
 }
 
 TEST(CliCrush, BadInputNamesTheKey) {

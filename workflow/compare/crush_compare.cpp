@@ -84,25 +84,53 @@ CrushCurve read_crush_curve(const std::string& source) {
   return c;
 }
 
-CrushMeasures measure_crush(const CrushCurve& c, double cfc, double common_stroke) {
+FirstLoading first_loading(const CrushCurve& c) {
+  const auto& f = c.force;
+  const double largest = *std::max_element(f.begin(), f.end());
+  FirstLoading l;
+  if (!(largest > 0)) return l;
+  std::size_t loaded = 0;
+  while (loaded + 1 < f.size() && f[loaded] < 0.05 * largest) ++loaded;
+  std::size_t onset = loaded;
+  while (onset > 0 && f[onset - 1] > 0.01 * largest) --onset;
+  if (onset > 0) --onset;
+  std::size_t peak = onset;
+  for (std::size_t i = onset; i < f.size(); ++i) {
+    if (f[i] > f[peak]) peak = i;
+    if (f[i] < f[peak] - 0.05 * largest) break;  // a fall, not the ringing of a rising force
+  }
+  l.contact_stroke = c.stroke[onset], l.peak_stroke = c.stroke[peak], l.peak_force = f[peak];
+  return l;
+}
+
+CrushMeasures measure_crush(const CrushCurve& c, double cfc, double common_stroke,
+                            double slope_window) {
   CrushMeasures m;
   const std::vector<double> f = filtered_force(c, cfc);
   std::size_t peak = 0;
   for (std::size_t i = 0; i < f.size(); ++i)
     if (f[i] > f[peak]) peak = i;
   m.peak_force = f[peak], m.peak_stroke = c.stroke[peak];
-  // The first loading: the secant between the strokes where the force first passes 10 % and 50 %
-  // of its peak (interpolated; a crush's later unloading and reloading stay out).
-  const auto first_crossing = [&](double level) {
-    for (std::size_t i = 0; i <= peak; ++i)
-      if (f[i] >= level)
-        return i == 0 ? c.stroke[0]
-                      : c.stroke[i - 1] + (level - f[i - 1]) / (f[i] - f[i - 1]) *
-                                              (c.stroke[i] - c.stroke[i - 1]);
-    return std::nan("");
-  };
-  const double s10 = first_crossing(0.1 * m.peak_force), s50 = first_crossing(0.5 * m.peak_force);
-  m.elastic_slope = s50 > s10 ? 0.4 * m.peak_force / (s50 - s10) : std::nan("");
+  const FirstLoading l = first_loading(c);
+  m.first = l;
+  m.contact_stroke = l.contact_stroke;
+  m.slope_window = slope_window > 0 ? slope_window : l.peak_stroke - l.contact_stroke;
+  // The least-squares line of the raw force over the window's samples: at a crush's speed the
+  // CFC filter resolves no less than about a millimetre of stroke, the first loading is shorter.
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  bool covered = false;
+  for (std::size_t i = 0; i < c.force.size(); ++i) {
+    const double x = c.stroke[i] - m.contact_stroke;
+    if (x < -1e-3 * m.slope_window) continue;
+    if (x > m.slope_window * (1 + 1e-3)) {
+      covered = true;
+      break;
+    }
+    covered = x >= m.slope_window * (1 - 1e-3);
+    n += 1, sx += x, sy += c.force[i], sxx += x * x, sxy += x * c.force[i];
+  }
+  const double det = n * sxx - sx * sx;
+  m.elastic_slope = n >= 3 && det > 0 && covered ? (n * sxy - sx * sy) / det : std::nan("");
   m.common_stroke = common_stroke;
   m.energy = work_to(c.stroke, c.force, common_stroke);
   return m;
@@ -124,33 +152,66 @@ int compare_crushes(const CrushCompareOptions& opt) {
   log->info("ncfsim {} | compare-crush | {} curves -> {} (CFC {:g})", kVersion, curves.size(),
             dir.string(), opt.cfc);
   std::vector<CrushMeasures> m;
-  for (const auto& c : curves) m.push_back(measure_crush(c, opt.cfc, common));
+  // The window: as asked, else the shortest first loading of all (from contact to the first
+  // peak), so that every source's slope is taken before anything fails in any of them.
+  double window = opt.slope_window;
+  if (!(window > 0)) {
+    window = 1e300;
+    for (const auto& c : curves) {
+      const auto l = first_loading(c);
+      if (l.peak_stroke > l.contact_stroke)
+        window = std::min(window, l.peak_stroke - l.contact_stroke);
+    }
+    if (window == 1e300) window = 0;
+  }
+  for (const auto& c : curves) {
+    m.push_back(measure_crush(c, opt.cfc, common, window));
+    if (std::isnan(m.back().elastic_slope))
+      log->warn(
+          "{}: no elastic slope: the curve has fewer than 3 samples over the {:.3f} mm "
+          "after its contact at {:.3f} mm, or ends before it (--slope-window)",
+          c.label, window * 1e3, m.back().contact_stroke * 1e3);
+  }
   const auto diff = [](double a, double b) { return b != 0 ? 100.0 * (a - b) / b : std::nan(""); };
   std::string csv =
       "label,elastic_slope_N_per_mm,peak_force_N,peak_stroke_mm,energy_J,to_stroke_mm,"
-      "slope_diff_pct,peak_diff_pct,energy_diff_pct\n";
+      "slope_diff_pct,peak_diff_pct,energy_diff_pct,contact_stroke_mm,first_peak_N,"
+      "first_peak_after_contact_mm\n";
   std::string md = fmt::format(
-      "# Crush curves compared (force filtered at CFC {:g}; energy to {:.3f} mm, the stroke all "
-      "reach)\n\n| source | elastic slope (N/mm) | peak (N) | at (mm) | energy (J) | slope, peak, "
-      "energy against {} |\n|---|---|---|---|---|---|\n",
-      opt.cfc, common * 1e3, curves[0].label);
-  nlohmann::json js = {{"stage", "compare-crush"},  {"ncfsim_version", kVersion},
-                       {"status", "completed"},     {"cfc_class", opt.cfc},
-                       {"common_stroke_m", common}, {"sources", nlohmann::json::array()}};
+      "# Crush curves compared (force filtered at CFC {:g}; elastic slope: the least-squares "
+      "line of the raw force over the first {:.3f} mm after each curve's contact; energy to "
+      "{:.3f} mm, the stroke all reach)\n\n| source | contact at (mm) | elastic slope (N/mm) | "
+      "first peak, raw (N at mm after contact) | peak (N) | at (mm) | energy (J) | slope, peak, "
+      "energy against {} |\n|---|---|---|---|---|---|---|---|\n",
+      opt.cfc, window * 1e3, common * 1e3, curves[0].label);
+  nlohmann::json js = {{"stage", "compare-crush"},
+                       {"ncfsim_version", kVersion},
+                       {"status", "completed"},
+                       {"cfc_class", opt.cfc},
+                       {"slope_window_m", window},
+                       {"common_stroke_m", common},
+                       {"sources", nlohmann::json::array()}};
   for (std::size_t i = 0; i < curves.size(); ++i) {
     const auto& a = m[i];
     const double ds = diff(a.elastic_slope, m[0].elastic_slope),
                  dp = diff(a.peak_force, m[0].peak_force), de = diff(a.energy, m[0].energy);
-    csv += fmt::format("{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4g},{:.4g},{:.4g}\n",
-                       curves[i].label, a.elastic_slope * 1e-3, a.peak_force, a.peak_stroke * 1e3,
-                       a.energy, common * 1e3, ds, dp, de);
+    csv += fmt::format(
+        "{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4g},{:.4g},{:.4g},{:.6g},{:.6g},{:.6g}\n",
+        curves[i].label, a.elastic_slope * 1e-3, a.peak_force, a.peak_stroke * 1e3, a.energy,
+        common * 1e3, ds, dp, de, a.contact_stroke * 1e3, a.first.peak_force,
+        (a.first.peak_stroke - a.first.contact_stroke) * 1e3);
     md += fmt::format(
-        "| {} | {:.1f} | {:.1f} | {:.3f} | {:.4f} | {} |\n", curves[i].label,
-        a.elastic_slope * 1e-3, a.peak_force, a.peak_stroke * 1e3, a.energy,
+        "| {} | {:.3f} | {:.1f} | {:.1f} at {:.3f} | {:.1f} | {:.3f} | {:.4f} | {} |\n",
+        curves[i].label, a.contact_stroke * 1e3, a.elastic_slope * 1e-3, a.first.peak_force,
+        (a.first.peak_stroke - a.first.contact_stroke) * 1e3, a.peak_force, a.peak_stroke * 1e3,
+        a.energy,
         i == 0 ? std::string("-") : fmt::format("{:+.1f} %, {:+.1f} %, {:+.1f} %", ds, dp, de));
     js["sources"].push_back({{"label", curves[i].label},
                              {"path", curves[i].path.string()},
+                             {"contact_stroke_m", a.contact_stroke},
                              {"elastic_slope_N_per_m", a.elastic_slope},
+                             {"first_peak_force_N", a.first.peak_force},
+                             {"first_peak_stroke_m", a.first.peak_stroke},
                              {"peak_force_N", a.peak_force},
                              {"peak_stroke_m", a.peak_stroke},
                              {"energy_J", a.energy}});

@@ -10,9 +10,11 @@
 
 #include "fem/case/stage_kinds.hpp"
 #include "fem/contact/penalty_contact.hpp"
+#include "fem/contact/segment_frame.hpp"
 #include "fem/contact/tied_contact.hpp"
 #include "fem/errors.hpp"
 #include "fem/io/stage_handoff.hpp"
+#include "fem/solver.hpp"
 #include "impact/tow_damage_material.hpp"
 #include "transfer/deck_export.hpp"
 #include "workflow/case/engine_case.hpp"
@@ -117,7 +119,7 @@ ExportResult export_impregnated(const std::filesystem::path& dir, const std::str
       throw InputError((dir / "ties.csv").string(), "", "malformed row: " + line);
     if (!tie_of.count(name)) {
       tie_of[name] = m.ties.size();
-      m.ties.push_back({name, {}, {}});
+      m.ties.push_back({name, {}, {}, {}});
     }
     auto& t = m.ties[tie_of[name]];
     const auto s = element_of.find(std::stoll(a)), ms = element_of.find(std::stoll(cc));
@@ -204,7 +206,7 @@ transfer::ExportModel crush_export_model(const EngineCase& ec) {
       if (t.face_pairs.empty())
         throw InputError(file, "contact",
                          "tie '" + t.name + "' is given by groups, not face pairs: not exported");
-      transfer::ExportTie x{t.name, {}, {}};
+      transfer::ExportTie x{t.name, {}, {}, {}};
       std::set<std::pair<std::int32_t, int>> slave, master;
       for (const auto& p : t.face_pairs) {
         slave.insert({p.slave_hex, p.slave_face});
@@ -278,6 +280,26 @@ transfer::ExportModel crush_export_model(const EngineCase& ec) {
   return m;
 }
 
+// The crush's ties as its solver builds them (each slave node at the nearest point of a paired
+// master face, a penalty stiffness from the masses and the first step): OpenRadioss has no tie of
+// that kind, so its deck carries them point by point.
+void add_tie_points(EngineCase& ec, transfer::ExportModel& m) {
+  const fem::ExplicitSolver solver(ec.model);
+  m.crush.first_step = solver.time_step();
+  std::size_t i = 0;
+  for (const auto& contact : ec.model.contacts) {
+    const auto* tie = dynamic_cast<const fem::TiedContact*>(contact.get());
+    if (!tie || !tie->config().slave_nodes.empty()) continue;  // the stitches' (not a bond)
+    auto& points = m.ties.at(i++).points;
+    for (std::size_t t = 0; t < tie->n_ties(); ++t) {
+      const auto r = tie->tie(t);
+      double N[4];
+      fem::segment_shape(r.xi, r.eta, N);
+      points.push_back({r.node, r.corner, {N[0], N[1], N[2], N[3]}, r.stiffness, r.area});
+    }
+  }
+}
+
 }  // namespace
 
 CrushExport export_crush_case(const std::filesystem::path& case_file,
@@ -286,13 +308,14 @@ CrushExport export_crush_case(const std::filesystem::path& case_file,
   if (format != "abaqus" && format != "lsdyna" && format != "radioss")
     throw InputError(case_file.string(), "--format",
                      "'" + format + "' is not allowed; one of 'abaqus', 'lsdyna', 'radioss'");
-  const EngineCase ec = load_engine_case(case_file, overrides);
+  EngineCase ec = load_engine_case(case_file, overrides);
   if (ec.kind != fem::stage_kind::kCrush || !ec.crush.enabled)
     throw InputError(case_file.string(), "case.kind",
                      "'" + ec.kind +
                          "': the export of a case writes a crush (kind = \"crush\"); export a "
                          "transfer run's folder for its model alone");
-  const transfer::ExportModel m = crush_export_model(ec);
+  transfer::ExportModel m = crush_export_model(ec);
+  if (format == "radioss") add_tie_points(ec, m);
   const std::filesystem::path dir =
       out_dir.empty() ? std::filesystem::path("results") / (ec.name + "_" + format) : out_dir;
   std::filesystem::create_directories(dir);
