@@ -222,16 +222,16 @@ void capture_stitches(ImpregnatedModel& m, const fem::io::StageFrame& frame,
     return point_of[node];
   };
   for (std::size_t b = 0; b < mesh.n_bar(); ++b) {
-    const auto i = static_cast<std::size_t>(mesh.bar2[2 * b]),
-               j = static_cast<std::size_t>(mesh.bar2[2 * b + 1]);
+    const auto i = static_cast<std::size_t>(mesh.bars().conn[2 * b]),
+               j = static_cast<std::size_t>(mesh.bars().conn[2 * b + 1]);
     if (!captured(i) || !captured(j)) {
       ++m.n_stitches_uncaptured;
       continue;
     }
     m.stitch.push_back({point(i), point(j)});
-    m.stitch_user_id.push_back(mesh.bar_user_id.empty() ? static_cast<std::int64_t>(b + 1)
-                                                        : mesh.bar_user_id[b]);
-    m.stitch_part.push_back(mesh.bar_part.empty() ? 0 : mesh.bar_part[b]);
+    m.stitch_user_id.push_back(mesh.bars().user_id.empty() ? static_cast<std::int64_t>(b + 1)
+                                                           : mesh.bars().user_id[b]);
+    m.stitch_part.push_back(mesh.bars().part.empty() ? 0 : mesh.bars().part[b]);
   }
 }
 
@@ -272,7 +272,7 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
   for (std::size_t e = 0; e < n_hex; ++e) {
     if (!mesh.hex_tow.empty() && mesh.hex_tow[e] < 0) continue;
     if (!spec.parts.empty() &&
-        std::find(spec.parts.begin(), spec.parts.end(), mesh.hex_part[e]) == spec.parts.end())
+        std::find(spec.parts.begin(), spec.parts.end(), mesh.hex().part[e]) == spec.parts.end())
       continue;
     ++m.n_candidates;
     if (eroded && eroded->n_components == 1 && eroded->values[e] > 0.5) {
@@ -283,8 +283,8 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
     std::array<V3, 8> X, x;
     V3 centre;
     for (std::size_t a = 0; a < 8; ++a) {
-      X[a] = at(X0, mesh.hex8[8 * e + a]);
-      x[a] = at(x1, mesh.hex8[8 * e + a]);
+      X[a] = at(X0, mesh.hex().conn[8 * e + a]);
+      x[a] = at(x1, mesh.hex().conn[8 * e + a]);
       centre += 0.125 * x[a];
     }
     if (spec.trim.radius > 0) {
@@ -313,7 +313,7 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
     kept.push_back(e);
     std::array<std::int32_t, 8> h{};
     for (std::size_t k = 0; k < 8; ++k) {
-      const auto node = static_cast<std::size_t>(mesh.hex8[8 * e + k]);
+      const auto node = static_cast<std::size_t>(mesh.hex().conn[8 * e + k]);
       if (node_of[node] < 0) {
         node_of[node] = static_cast<std::int32_t>(tows.current.size());
         tows.current.push_back(at(x1, static_cast<std::int64_t>(node)));
@@ -344,9 +344,9 @@ ImpregnatedModel build_impregnated_model(const fem::io::StageFrame& frame,
   for (double vf : map.class_vf)
     m.classes.push_back(impregnated_tow(spec.fibre, spec.resin, vf, spec.compressive_ratio));
   for (auto e : kept) {
-    m.hex_user_id.push_back(mesh.hex_user_id.empty() ? static_cast<std::int64_t>(e + 1)
-                                                     : mesh.hex_user_id[e]);
-    m.hex_part.push_back(mesh.hex_part[e]);
+    m.hex_user_id.push_back(mesh.hex().user_id.empty() ? static_cast<std::int64_t>(e + 1)
+                                                       : mesh.hex().user_id[e]);
+    m.hex_part.push_back(mesh.hex().part[e]);
     m.hex_ply.push_back(mesh.hex_ply.empty() ? 0 : mesh.hex_ply[e]);
     m.hex_tow.push_back(mesh.hex_tow.empty() ? static_cast<std::int32_t>(e) : mesh.hex_tow[e]);
   }

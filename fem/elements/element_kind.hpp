@@ -1,8 +1,8 @@
 #pragma once
 // The element kinds the engine knows, with what the rest of the code may ask of a kind without
-// naming it: nodes per element, names for messages and output, and the faces that bound a solid
-// element (contact surfaces are made of them). A new kind adds an enumerator here, a row in each
-// table below and a group in fem/elements/ (docs/architecture.md).
+// naming it: nodes per element, names for messages and output files, and the faces that bound a
+// solid element (contact surfaces are made of them). A new kind adds an enumerator here, a row in
+// each table below and a group in fem/elements/ (docs/architecture.md).
 #include <array>
 #include <cstdint>
 #include <span>
@@ -34,6 +34,30 @@ constexpr const char* element_plural(ElementKind k) {
 constexpr const char* element_kind_name(ElementKind k) {
   constexpr const char* n[] = {"hex8", "bar2", "quad4"};
   return n[static_cast<int>(k)];
+}
+
+/// What the result files (fem/io/result_writers.hpp) call a kind's arrays and how they draw it:
+/// /mesh/<element_kind_name> (connectivity, and the frames' cell-field group), /mesh/<part>,
+/// /mesh/<user_id>, /mesh/<material> (an index into material_names, or into bar_law_names for a
+/// kind whose law is a bar law), its results.xdmf grid and topology, its VTK cell type.
+struct ElementOutput {
+  const char* part;
+  const char* user_id;
+  const char* material;
+  bool bar_law;          // material indexes the bar laws
+  bool always_in_file;   // /mesh/<name> and <part> written even when empty (files before shells)
+  const char* grid;      // results.xdmf Uniform grid
+  const char* topology;  // its Topology attributes
+  int vtk_cell_type;     // VTK_HEXAHEDRON, VTK_LINE, VTK_QUAD
+};
+constexpr ElementOutput element_output(ElementKind k) {
+  constexpr ElementOutput o[] = {{"hex_part", "hex_user_id", "hex_material", false, true, "solids",
+                                  "TopologyType=\"Hexahedron\"", 12},
+                                 {"bar_part", "bar_user_id", "bar_material", true, true, "bars",
+                                  "TopologyType=\"Polyline\" NodesPerElement=\"2\"", 3},
+                                 {"quad_part", "quad_user_id", "quad_material", false, false,
+                                  "shells", "TopologyType=\"Quadrilateral\"", 9}};
+  return o[static_cast<int>(k)];
 }
 
 /// A two-node element must join two different nodes (checked by Mesh::validate).

@@ -53,40 +53,39 @@ void check_optional(const std::vector<T>& values, std::size_t n, const char* nam
   }
 }
 
-// The shell (quad4) arrays: connectivity and parts like the other kinds, the optional per-shell
-// arrays, and the values the hand-off gives a meaning to (thickness, material index).
-void check_shells(const ResultMesh& mesh) {
-  if (mesh.quad4.size() % 4 != 0) {
-    throw std::invalid_argument("ResultMesh: quad4 has " + std::to_string(mesh.quad4.size()) +
-                                " node ids, not a multiple of 4");
+// One kind's cells: connectivity and parts, the optional hand-off arrays, material indices within
+// their names where those are given.
+void check_cells(const ResultMesh& mesh, ElementKind k) {
+  const ResultCells& c = mesh.of(k);
+  const auto nodes = static_cast<std::size_t>(nodes_per_element(k));
+  const ElementOutput out = element_output(k);
+  const char* name = element_kind_name(k);
+  if (c.conn.size() % nodes != 0) {
+    throw std::invalid_argument(std::string("ResultMesh: ") + name + " has " +
+                                std::to_string(c.conn.size()) + " node ids, not a multiple of " +
+                                std::to_string(nodes));
   }
-  const std::size_t n = mesh.n_quad();
-  if (mesh.quad_part.size() != n) {
-    throw std::invalid_argument("ResultMesh: quad_part has " +
-                                std::to_string(mesh.quad_part.size()) + " entries for " +
-                                std::to_string(n) + " shells");
+  const std::size_t n = mesh.n_of(k);
+  if (c.part.size() != n) {
+    throw std::invalid_argument(std::string("ResultMesh: ") + out.part + " has " +
+                                std::to_string(c.part.size()) + " entries for " +
+                                std::to_string(n) + " " + element_plural(k));
   }
-  check_node_ids(mesh.quad4, 4, mesh.n_points(), "shell");
-  check_part_ids(mesh.quad_part, "shell");
-  check_optional(mesh.quad_user_id, n, "quad_user_id", "shells");
-  check_optional(mesh.quad_material, n, "quad_material", "shells");
-  check_optional(mesh.quad_thickness, n, "quad_thickness", "shells");
-  for (std::size_t i = 0; i < mesh.quad_thickness.size(); ++i) {
-    const double t = mesh.quad_thickness[i];
-    if (!std::isfinite(t) || t <= 0) {
-      throw std::invalid_argument("ResultMesh: " + entity_text("shell", i) + " has thickness " +
-                                  detail::format_double(t) + " m, not a finite value > 0");
-    }
-  }
-  const auto n_materials = static_cast<std::int64_t>(mesh.material_names.size());
-  for (std::size_t i = 0; i < mesh.quad_material.size(); ++i) {
-    const std::int32_t m = mesh.quad_material[i];
-    if (m < -1 || (n_materials > 0 && m >= n_materials)) {
+  check_node_ids(c.conn, nodes, mesh.n_points(), element_noun(k));
+  check_part_ids(c.part, element_noun(k));
+  check_optional(c.user_id, n, out.user_id, element_plural(k));
+  check_optional(c.material, n, out.material, element_plural(k));
+  const auto& names = out.bar_law ? mesh.bar_law_names : mesh.material_names;
+  const auto n_names = static_cast<std::int64_t>(names.size());
+  for (std::size_t i = 0; i < c.material.size(); ++i) {
+    const std::int32_t m = c.material[i];
+    if (m < -1 || (n_names > 0 && m >= n_names)) {
       throw std::invalid_argument(
-          "ResultMesh: " + entity_text("shell", i) + " has material index " + std::to_string(m) +
-          ", allowed -1 (none)" +
-          (n_materials > 0 ? " or [0, " + std::to_string(n_materials) + ") (material_names)"
-                           : std::string(" or >= 0")));
+          "ResultMesh: " + entity_text(element_noun(k), i) + " has material index " +
+          std::to_string(m) + ", allowed -1 (none)" +
+          (n_names > 0 ? " or [0, " + std::to_string(n_names) + ") (" +
+                             (out.bar_law ? "bar_law_names" : "material_names") + ")"
+                       : std::string(" or >= 0")));
     }
   }
 }
@@ -98,34 +97,18 @@ void validate_mesh(const ResultMesh& mesh) {
     throw std::invalid_argument("ResultMesh: points has " + std::to_string(mesh.points.size()) +
                                 " values, not a multiple of 3");
   }
-  if (mesh.hex8.size() % 8 != 0) {
-    throw std::invalid_argument("ResultMesh: hex8 has " + std::to_string(mesh.hex8.size()) +
-                                " node ids, not a multiple of 8");
-  }
-  if (mesh.bar2.size() % 2 != 0) {
-    throw std::invalid_argument("ResultMesh: bar2 has " + std::to_string(mesh.bar2.size()) +
-                                " node ids, not a multiple of 2");
-  }
-  if (mesh.hex_part.size() != mesh.n_hex()) {
-    throw std::invalid_argument("ResultMesh: hex_part has " + std::to_string(mesh.hex_part.size()) +
-                                " entries for " + std::to_string(mesh.n_hex()) + " hexahedra");
-  }
-  if (mesh.bar_part.size() != mesh.n_bar()) {
-    throw std::invalid_argument("ResultMesh: bar_part has " + std::to_string(mesh.bar_part.size()) +
-                                " entries for " + std::to_string(mesh.n_bar()) + " bars");
-  }
-  check_node_ids(mesh.hex8, 8, mesh.n_points(), "hexahedron");
-  check_node_ids(mesh.bar2, 2, mesh.n_points(), "bar");
-  check_part_ids(mesh.hex_part, "hexahedron");
-  check_part_ids(mesh.bar_part, "bar");
+  for (ElementKind k : kElementKinds) check_cells(mesh, k);
   check_optional(mesh.node_user_id, mesh.n_points(), "node_user_id", "points");
-  check_optional(mesh.hex_user_id, mesh.n_hex(), "hex_user_id", "hexahedra");
-  check_optional(mesh.hex_material, mesh.n_hex(), "hex_material", "hexahedra");
   check_optional(mesh.hex_ply, mesh.n_hex(), "hex_ply", "hexahedra");
   check_optional(mesh.hex_tow, mesh.n_hex(), "hex_tow", "hexahedra");
-  check_optional(mesh.bar_user_id, mesh.n_bar(), "bar_user_id", "bars");
-  check_optional(mesh.bar_material, mesh.n_bar(), "bar_material", "bars");
-  check_shells(mesh);
+  check_optional(mesh.quad_thickness, mesh.n_quad(), "quad_thickness", "shells");
+  for (std::size_t i = 0; i < mesh.quad_thickness.size(); ++i) {
+    const double t = mesh.quad_thickness[i];
+    if (!std::isfinite(t) || t <= 0) {
+      throw std::invalid_argument("ResultMesh: " + entity_text("shell", i) + " has thickness " +
+                                  detail::format_double(t) + " m, not a finite value > 0");
+    }
+  }
 }
 
 void validate_frame(const ResultMesh& mesh, const Frame& frame) {

@@ -131,19 +131,29 @@ void read_optional(const std::filesystem::path& file, hid_t loc, const char* nam
     read_dataset(file, loc, name, mem_type, resize_vec<T>, &target);
 }
 
-// The shells (quad4) of /mesh, present only in a file whose mesh has them.
-void read_shells(const std::filesystem::path& file, hid_t g, ResultMesh& mesh) {
-  if (H5Lexists(g, "quad4", H5P_DEFAULT) <= 0) return;
+// A kind's cells of /mesh, present where the file has its connectivity (shells only in a file
+// whose mesh has them).
+void read_cells(const std::filesystem::path& file, hid_t g, ElementKind k, ResultMesh& mesh) {
+  const char* name = element_kind_name(k);
+  if (H5Lexists(g, name, H5P_DEFAULT) <= 0) return;
+  ResultCells& c = mesh.of(k);
   const auto dims =
-      read_dataset(file, g, "quad4", H5T_NATIVE_INT64, resize_vec<std::int64_t>, &mesh.quad4);
-  if (dims.size() != 2 || dims[1] != 4)
-    fail(file, "dataset '/mesh/quad4' is not [n_quad, 4] (4 node ids per shell)");
-  if (H5Lexists(g, "quad_part", H5P_DEFAULT) <= 0)
-    fail(file, "dataset '/mesh/quad4' without '/mesh/quad_part'");
-  read_dataset(file, g, "quad_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>, &mesh.quad_part);
-  read_optional(file, g, "quad_user_id", H5T_NATIVE_INT64, mesh.quad_user_id);
-  read_optional(file, g, "quad_material", H5T_NATIVE_INT32, mesh.quad_material);
-  read_optional(file, g, "quad_thickness", H5T_NATIVE_DOUBLE, mesh.quad_thickness);
+      read_dataset(file, g, name, H5T_NATIVE_INT64, resize_vec<std::int64_t>, &c.conn);
+  const auto nodes = static_cast<hsize_t>(nodes_per_element(k));
+  const ElementOutput out = element_output(k);
+  if (dims.size() != 2 || dims[1] != nodes) {
+    const std::string count =
+        "n_" + std::string(out.part).substr(0, std::string(out.part).find('_'));
+    fail(file, std::string("dataset '/mesh/") + name + "' is not [" + count + ", " +
+                   std::to_string(nodes) + "] (" + std::to_string(nodes) + " node ids per " +
+                   element_noun(k) + ")");
+  }
+  if (H5Lexists(g, out.part, H5P_DEFAULT) <= 0)
+    fail(file, std::string("dataset '/mesh/") + name + "' without '/mesh/" + out.part + "'");
+  read_dataset(file, g, out.part, H5T_NATIVE_INT32, resize_vec<std::int32_t>, &c.part);
+  // The stage hand-off datasets (format_version 2; absent in older files).
+  read_optional(file, g, out.user_id, H5T_NATIVE_INT64, c.user_id);
+  read_optional(file, g, out.material, H5T_NATIVE_INT32, c.material);
 }
 
 }  // namespace
@@ -162,27 +172,13 @@ ResultReader::ResultReader(std::filesystem::path h5) : path_(std::move(h5)) {
   Handle g(H5Gopen2(f.id, "mesh", H5P_DEFAULT), H5Gclose);
   if (g.id < 0) fail(path_, "no group /mesh");
   read_dataset(path_, g.id, "points", H5T_NATIVE_DOUBLE, resize_vec<double>, &mesh_.points);
-  if (H5Lexists(g.id, "hex8", H5P_DEFAULT) > 0)
-    read_dataset(path_, g.id, "hex8", H5T_NATIVE_INT64, resize_vec<std::int64_t>, &mesh_.hex8);
-  if (H5Lexists(g.id, "bar2", H5P_DEFAULT) > 0)
-    read_dataset(path_, g.id, "bar2", H5T_NATIVE_INT64, resize_vec<std::int64_t>, &mesh_.bar2);
-  if (H5Lexists(g.id, "hex_part", H5P_DEFAULT) > 0)
-    read_dataset(path_, g.id, "hex_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>,
-                 &mesh_.hex_part);
-  if (H5Lexists(g.id, "bar_part", H5P_DEFAULT) > 0)
-    read_dataset(path_, g.id, "bar_part", H5T_NATIVE_INT32, resize_vec<std::int32_t>,
-                 &mesh_.bar_part);
+  for (ElementKind k : kElementKinds) read_cells(path_, g.id, k, mesh_);
   if (H5Lexists(g.id, "part_names", H5P_DEFAULT) > 0)
     mesh_.part_names = read_strings(path_, g.id, "part_names");
-  // The stage hand-off datasets (format_version 2; absent in older files).
   read_optional(path_, g.id, "node_user_id", H5T_NATIVE_INT64, mesh_.node_user_id);
-  read_optional(path_, g.id, "hex_user_id", H5T_NATIVE_INT64, mesh_.hex_user_id);
-  read_optional(path_, g.id, "bar_user_id", H5T_NATIVE_INT64, mesh_.bar_user_id);
-  read_optional(path_, g.id, "hex_material", H5T_NATIVE_INT32, mesh_.hex_material);
-  read_optional(path_, g.id, "bar_material", H5T_NATIVE_INT32, mesh_.bar_material);
   read_optional(path_, g.id, "hex_ply", H5T_NATIVE_INT32, mesh_.hex_ply);
   read_optional(path_, g.id, "hex_tow", H5T_NATIVE_INT32, mesh_.hex_tow);
-  read_shells(path_, g.id, mesh_);
+  read_optional(path_, g.id, "quad_thickness", H5T_NATIVE_DOUBLE, mesh_.quad_thickness);
   if (H5Lexists(g.id, "material_names", H5P_DEFAULT) > 0)
     mesh_.material_names = read_strings(path_, g.id, "material_names");
   if (H5Lexists(g.id, "bar_law_names", H5P_DEFAULT) > 0)
@@ -216,7 +212,7 @@ StoredFrame ResultReader::frame(std::size_t index) const {
     if (c.id >= 0) H5Aread(c.id, H5T_NATIVE_INT, &fr.cycle);
   }
   read_dataset(path_, gid, "coordinates", H5T_NATIVE_DOUBLE, resize_vec<double>, &fr.coordinates);
-  const std::size_t nh = mesh_.n_hex(), nb = mesh_.n_bar(), n_cells = mesh_.n_cells();
+  const std::size_t n_cells = mesh_.n_cells();
   for (const auto& name : list_links(gid)) {
     if (name == "coordinates" || is_group(gid, name)) continue;
     FrameField ff;
@@ -226,15 +222,12 @@ StoredFrame ResultReader::frame(std::size_t index) const {
     ff.n_components = dims.size() > 1 ? static_cast<int>(dims[1]) : 1;
     fr.fields.push_back(std::move(ff));
   }
-  // Cell fields: join the hex, bar and shell slices in that order (missing slice -> NaN).
+  // Cell fields: join the kinds' slices in kind order (missing slice -> NaN).
   std::map<std::string, FrameField> cells;
-  struct Slice {
-    const char* kind;
-    std::size_t first_cell;
-  };
-  for (const Slice slice : {Slice{"hex8", 0}, Slice{"bar2", nh}, Slice{"quad4", nh + nb}}) {
-    if (H5Lexists(gid, slice.kind, H5P_DEFAULT) <= 0) continue;
-    Handle cg(H5Gopen2(gid, slice.kind, H5P_DEFAULT), H5Gclose);
+  for (ElementKind k : kElementKinds) {
+    const char* kind = element_kind_name(k);
+    if (H5Lexists(gid, kind, H5P_DEFAULT) <= 0) continue;
+    Handle cg(H5Gopen2(gid, kind, H5P_DEFAULT), H5Gclose);
     for (const auto& name : list_links(cg.id)) {
       std::vector<double> vals;
       const auto dims =
@@ -247,7 +240,7 @@ StoredFrame ResultReader::frame(std::size_t index) const {
                          std::numeric_limits<double>::quiet_NaN());
       }
       if (nc != ff.n_components) continue;
-      const std::size_t offset = static_cast<std::size_t>(nc) * slice.first_cell;
+      const std::size_t offset = static_cast<std::size_t>(nc) * mesh_.first_cell(k);
       for (std::size_t i = 0; i < vals.size() && offset + i < ff.values.size(); ++i)
         ff.values[offset + i] = vals[i];
     }

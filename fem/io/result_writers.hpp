@@ -64,44 +64,72 @@
 //
 // Errors: bad input -> std::invalid_argument; HDF5/VTK/file-system failure -> std::runtime_error
 // naming the file (and HDF5 object); write_frame after close() -> std::logic_error.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "fem/elements/element_kind.hpp"
+
 namespace ncfsim::fem::io {
 
+/// One element kind's cells (fem/elements/element_kind.hpp: its names in the files): the writers,
+/// the reader and the renderer go over the kinds, so a new kind needs no field of its own here.
+struct ResultCells {
+  std::vector<std::int64_t> conn;  ///< nodes_per_element ids per cell (VTK ordering; a shell's
+                                   ///< counter-clockwise, its normal by the right-hand rule)
+  std::vector<std::int32_t> part;  ///< part id per cell
+  // Stage hand-off (optional: empty = not known, not written; else one per cell).
+  std::vector<std::int64_t> user_id;  ///< element number given by the user
+  std::vector<std::int32_t>
+      material;  ///< index into material_names (a bar: bar_law_names); -1: none
+};
+
 struct ResultMesh {
-  std::vector<double> points;          ///< reference coordinates, xyz interleaved [3*n_points]
-  std::vector<std::int64_t> hex8;      ///< 8 node ids per hexahedron (VTK/Abaqus ordering)
-  std::vector<std::int64_t> bar2;      ///< 2 node ids per bar
-  std::vector<std::int32_t> hex_part;  ///< part id per hexahedron
-  std::vector<std::int32_t> bar_part;  ///< part id per bar
+  std::vector<double> points;  ///< reference coordinates, xyz interleaved [3*n_points]
+  std::array<ResultCells, kElementKinds.size()> cells;  ///< per ElementKind, in kind order
   std::vector<std::string> part_names;
-  // Stage hand-off (optional: empty = not known, not written; else sized like the elements).
+  // Stage hand-off (optional: empty = not known, not written; else sized like its entities).
   std::vector<std::int64_t> node_user_id;  ///< per point
-  std::vector<std::int64_t> hex_user_id;   ///< per hexahedron
-  std::vector<std::int64_t> bar_user_id;   ///< per bar
-  std::vector<std::int32_t> hex_material;  ///< index into material_names (-1: none)
-  std::vector<std::int32_t> bar_material;  ///< index into bar_law_names (-1: none)
   std::vector<std::string> material_names;
   std::vector<std::string> bar_law_names;
-  std::vector<std::int32_t> hex_ply;  ///< fabric ply per hexahedron (-1: not a tow)
-  std::vector<std::int32_t> hex_tow;  ///< fabric tow per hexahedron (-1: not a tow)
-  // Shells (quad4), after the hexahedra and bars in every per-cell order.
-  std::vector<std::int64_t> quad4;          ///< 4 node ids per shell, counter-clockwise (VTK_QUAD)
-  std::vector<std::int32_t> quad_part;      ///< part id per shell
-  std::vector<std::int64_t> quad_user_id;   ///< per shell (optional, like hex_user_id)
-  std::vector<std::int32_t> quad_material;  ///< index into material_names (-1: none; optional)
-  std::vector<double> quad_thickness;       ///< m, > 0 (optional: empty = unknown)
+  std::vector<std::int32_t> hex_ply;   ///< fabric ply per hexahedron (-1: not a tow)
+  std::vector<std::int32_t> hex_tow;   ///< fabric tow per hexahedron (-1: not a tow)
+  std::vector<double> quad_thickness;  ///< m per shell, > 0 (optional: empty = unknown)
+
+  ResultCells& of(ElementKind k) { return cells[static_cast<std::size_t>(k)]; }
+  const ResultCells& of(ElementKind k) const { return cells[static_cast<std::size_t>(k)]; }
+  ResultCells& hex() { return of(ElementKind::Hex8); }
+  const ResultCells& hex() const { return of(ElementKind::Hex8); }
+  ResultCells& bars() { return of(ElementKind::Bar2); }
+  const ResultCells& bars() const { return of(ElementKind::Bar2); }
+  ResultCells& shells() { return of(ElementKind::Quad4); }
+  const ResultCells& shells() const { return of(ElementKind::Quad4); }
 
   std::size_t n_points() const { return points.size() / 3; }
-  std::size_t n_hex() const { return hex8.size() / 8; }
-  std::size_t n_bar() const { return bar2.size() / 2; }
-  std::size_t n_quad() const { return quad4.size() / 4; }
+  std::size_t n_of(ElementKind k) const {
+    return of(k).conn.size() / static_cast<std::size_t>(nodes_per_element(k));
+  }
+  std::size_t n_hex() const { return n_of(ElementKind::Hex8); }
+  std::size_t n_bar() const { return n_of(ElementKind::Bar2); }
+  std::size_t n_quad() const { return n_of(ElementKind::Quad4); }
+  /// Where kind k's cells start in the per-cell order (the kinds in order).
+  std::size_t first_cell(ElementKind k) const {
+    std::size_t n = 0;
+    for (ElementKind j : kElementKinds) {
+      if (j == k) break;
+      n += n_of(j);
+    }
+    return n;
+  }
   /// Cells of every kind: the length of a one-component cell field.
-  std::size_t n_cells() const { return n_hex() + n_bar() + n_quad(); }
+  std::size_t n_cells() const {
+    std::size_t n = 0;
+    for (ElementKind k : kElementKinds) n += n_of(k);
+    return n;
+  }
 };
 
 /// A nodal field has values [n_components * n_points]; a cell field [n_components * (n_hex +

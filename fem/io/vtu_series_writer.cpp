@@ -66,17 +66,19 @@ struct VtuSeriesWriter::Impl {
   }
 };
 
+static_assert(element_output(ElementKind::Hex8).vtk_cell_type == VTK_HEXAHEDRON &&
+              element_output(ElementKind::Bar2).vtk_cell_type == VTK_LINE &&
+              element_output(ElementKind::Quad4).vtk_cell_type == VTK_QUAD);
+
 void VtuSeriesWriter::Impl::build_topology() {
-  const std::size_t n_hex = mesh.n_hex();
-  const std::size_t n_bar = mesh.n_bar();
-  const std::size_t n_quad = mesh.n_quad();
   const std::size_t n_cells = mesh.n_cells();
+  std::size_t n_ids = 0;
+  for (const ResultCells& kc : mesh.cells) n_ids += kc.conn.size();
 
   vtkNew<vtkIdTypeArray> offsets;
   offsets->SetNumberOfValues(static_cast<vtkIdType>(n_cells + 1));
   vtkNew<vtkIdTypeArray> connectivity;
-  connectivity->SetNumberOfValues(
-      static_cast<vtkIdType>(mesh.hex8.size() + mesh.bar2.size() + mesh.quad4.size()));
+  connectivity->SetNumberOfValues(static_cast<vtkIdType>(n_ids));
   cell_types = vtkSmartPointer<vtkUnsignedCharArray>::New();
   cell_types->SetNumberOfValues(static_cast<vtkIdType>(n_cells));
   part_id = vtkSmartPointer<vtkIntArray>::New();
@@ -85,23 +87,16 @@ void VtuSeriesWriter::Impl::build_topology() {
 
   vtkIdType c = 0, k = 0;
   offsets->SetValue(0, 0);
-  for (std::size_t e = 0; e < n_hex; ++e, ++c) {
-    for (int j = 0; j < 8; ++j) connectivity->SetValue(k++, mesh.hex8[8 * e + j]);
-    offsets->SetValue(c + 1, k);
-    cell_types->SetValue(c, VTK_HEXAHEDRON);
-    part_id->SetValue(c, mesh.hex_part[e]);
-  }
-  for (std::size_t e = 0; e < n_bar; ++e, ++c) {
-    for (int j = 0; j < 2; ++j) connectivity->SetValue(k++, mesh.bar2[2 * e + j]);
-    offsets->SetValue(c + 1, k);
-    cell_types->SetValue(c, VTK_LINE);
-    part_id->SetValue(c, mesh.bar_part[e]);
-  }
-  for (std::size_t e = 0; e < n_quad; ++e, ++c) {
-    for (int j = 0; j < 4; ++j) connectivity->SetValue(k++, mesh.quad4[4 * e + j]);
-    offsets->SetValue(c + 1, k);
-    cell_types->SetValue(c, VTK_QUAD);
-    part_id->SetValue(c, mesh.quad_part[e]);
+  for (ElementKind kind : kElementKinds) {
+    const ResultCells& kc = mesh.of(kind);
+    const auto nodes = static_cast<std::size_t>(nodes_per_element(kind));
+    const auto type = static_cast<unsigned char>(element_output(kind).vtk_cell_type);
+    for (std::size_t e = 0; e < mesh.n_of(kind); ++e, ++c) {
+      for (std::size_t j = 0; j < nodes; ++j) connectivity->SetValue(k++, kc.conn[nodes * e + j]);
+      offsets->SetValue(c + 1, k);
+      cell_types->SetValue(c, type);
+      part_id->SetValue(c, kc.part[e]);
+    }
   }
   cells = vtkSmartPointer<vtkCellArray>::New();
   cells->SetData(offsets, connectivity);

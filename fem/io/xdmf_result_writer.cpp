@@ -2,6 +2,7 @@
 // Layout and consistency rules: see result_writers.hpp.
 #include <hdf5.h>
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <sstream>
@@ -224,16 +225,6 @@ const char* attribute_type(int n_components) {
   }
 }
 
-/// One Uniform grid of a frame: a kind's cells, where its connectivity, parts and cell fields are.
-struct GridBlock {
-  const char* name;      // "solids", "bars", "shells"
-  const char* topology;  // the Topology element's attributes
-  int nodes_per_cell;
-  std::size_t n_cells;
-  const char* kind;  // "hex8", "bar2", "quad4": /mesh/<kind> and /frames/NNNNNN/<kind>/
-  const char* part;  // /mesh/<part>
-};
-
 }  // namespace
 
 // --- Writer
@@ -262,8 +253,8 @@ struct XdmfResultWriter::Impl {
   void write_handoff_datasets(hid_t mesh_group) const;
   void write_frame_h5(const Frame& frame, const std::string& group) const;
   std::string xdmf_text() const;
-  void append_uniform_grid(std::ostringstream& x, const FrameRecord& fr,
-                           const GridBlock& block) const;
+  /// One Uniform grid of a frame: a kind's cells, their parts and fields.
+  void append_uniform_grid(std::ostringstream& x, const FrameRecord& fr, ElementKind k) const;
 };
 
 void XdmfResultWriter::Impl::create_h5() const {
@@ -282,26 +273,24 @@ void XdmfResultWriter::Impl::create_h5() const {
   {
     H5Id g = create_group(file.get(), "mesh", at("/mesh"));
     const auto nd = static_cast<hsize_t>(mesh.n_points());
-    const auto nh = static_cast<hsize_t>(mesh.n_hex());
-    const auto nb = static_cast<hsize_t>(mesh.n_bar());
     write_dataset(g.get(), "points", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {nd, 3}, mesh.points.data(),
                   at("/mesh/points"));
-    write_dataset(g.get(), "hex8", H5T_STD_I64LE, H5T_NATIVE_INT64, {nh, 8}, mesh.hex8.data(),
-                  at("/mesh/hex8"));
-    write_dataset(g.get(), "bar2", H5T_STD_I64LE, H5T_NATIVE_INT64, {nb, 2}, mesh.bar2.data(),
-                  at("/mesh/bar2"));
-    write_dataset(g.get(), "hex_part", H5T_STD_I32LE, H5T_NATIVE_INT32, {nh}, mesh.hex_part.data(),
-                  at("/mesh/hex_part"));
-    write_dataset(g.get(), "bar_part", H5T_STD_I32LE, H5T_NATIVE_INT32, {nb}, mesh.bar_part.data(),
-                  at("/mesh/bar_part"));
+    // A kind written only with cells (shells) keeps a file without them as it was before it.
+    auto cells = [&](ElementKind k) {
+      const auto n = static_cast<hsize_t>(mesh.n_of(k));
+      const char* name = element_kind_name(k);
+      write_dataset(g.get(), name, H5T_STD_I64LE, H5T_NATIVE_INT64,
+                    {n, static_cast<hsize_t>(nodes_per_element(k))}, mesh.of(k).conn.data(),
+                    at(std::string("/mesh/") + name));
+      const char* part = element_output(k).part;
+      write_dataset(g.get(), part, H5T_STD_I32LE, H5T_NATIVE_INT32, {n}, mesh.of(k).part.data(),
+                    at(std::string("/mesh/") + part));
+    };
+    for (ElementKind k : kElementKinds)
+      if (element_output(k).always_in_file) cells(k);
     write_string_dataset(g.get(), "part_names", mesh.part_names, at("/mesh/part_names"));
-    if (const auto nq = static_cast<hsize_t>(mesh.n_quad()); nq > 0) {
-      // Only with shells: a file without them keeps the layout it had before shells.
-      write_dataset(g.get(), "quad4", H5T_STD_I64LE, H5T_NATIVE_INT64, {nq, 4}, mesh.quad4.data(),
-                    at("/mesh/quad4"));
-      write_dataset(g.get(), "quad_part", H5T_STD_I32LE, H5T_NATIVE_INT32, {nq},
-                    mesh.quad_part.data(), at("/mesh/quad_part"));
-    }
+    for (ElementKind k : kElementKinds)
+      if (!element_output(k).always_in_file && mesh.n_of(k) > 0) cells(k);
     write_handoff_datasets(g.get());
   }
   create_group(file.get(), "frames", at("/frames"));
@@ -322,14 +311,12 @@ void XdmfResultWriter::Impl::write_handoff_datasets(hid_t g) const {
                   v.data(), at(std::string("/mesh/") + name));
   };
   ids64("node_user_id", mesh.node_user_id);
-  ids64("hex_user_id", mesh.hex_user_id);
-  ids64("bar_user_id", mesh.bar_user_id);
-  ids32("hex_material", mesh.hex_material);
-  ids32("bar_material", mesh.bar_material);
+  for (ElementKind k : kElementKinds) {
+    ids64(element_output(k).user_id, mesh.of(k).user_id);
+    ids32(element_output(k).material, mesh.of(k).material);
+  }
   ids32("hex_ply", mesh.hex_ply);
   ids32("hex_tow", mesh.hex_tow);
-  ids64("quad_user_id", mesh.quad_user_id);
-  ids32("quad_material", mesh.quad_material);
   if (!mesh.quad_thickness.empty()) {
     write_dataset(g, "quad_thickness", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
                   {static_cast<hsize_t>(mesh.quad_thickness.size())}, mesh.quad_thickness.data(),
@@ -372,7 +359,10 @@ void XdmfResultWriter::Impl::write_frame_h5(const Frame& frame, const std::strin
     write_dataset(g.get(), "displacement", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {nd, 3},
                   frame.displacement.data(), at(group + "/displacement"));
 
-    H5Id hex_group, bar_group, quad_group;
+    // A cell field: a slice per kind under /frames/NNNNNN/<kind>/ (a kind that is left out of
+    // the file without cells has no group).
+    std::array<H5Id, kElementKinds.size()> kind_group;
+    bool kind_groups_made = false;
     for (const FrameField& f : frame.fields) {
       if (!f.on_cells) {
         write_dataset(g.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
@@ -380,25 +370,18 @@ void XdmfResultWriter::Impl::write_frame_h5(const Frame& frame, const std::strin
                       at(group + "/" + f.name));
         continue;
       }
-      if (hex_group.get() < 0) {
-        hex_group = create_group(g.get(), "hex8", at(group + "/hex8"));
-        bar_group = create_group(g.get(), "bar2", at(group + "/bar2"));
-        if (mesh.n_quad() > 0) quad_group = create_group(g.get(), "quad4", at(group + "/quad4"));
-      }
       const auto nc = static_cast<std::size_t>(f.n_components);
-      const std::size_t n_hex_values = mesh.n_hex() * nc;
-      write_dataset(hex_group.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                    field_dims(mesh.n_hex(), f.n_components), f.values.data(),
-                    at(group + "/hex8/" + f.name));
-      write_dataset(bar_group.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                    field_dims(mesh.n_bar(), f.n_components), f.values.data() + n_hex_values,
-                    at(group + "/bar2/" + f.name));
-      if (mesh.n_quad() > 0) {
-        write_dataset(quad_group.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                      field_dims(mesh.n_quad(), f.n_components),
-                      f.values.data() + n_hex_values + mesh.n_bar() * nc,
-                      at(group + "/quad4/" + f.name));
+      for (ElementKind k : kElementKinds) {
+        if (!element_output(k).always_in_file && mesh.n_of(k) == 0) continue;
+        const std::string kind = element_kind_name(k);
+        H5Id& kg = kind_group[static_cast<std::size_t>(k)];
+        if (!kind_groups_made) kg = create_group(g.get(), kind, at(group + "/" + kind));
+        write_dataset(kg.get(), f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                      field_dims(mesh.n_of(k), f.n_components),
+                      f.values.data() + mesh.first_cell(k) * nc,
+                      at(group + "/" + kind + "/" + f.name));
       }
+      kind_groups_made = true;
     }
   }
   const auto n_frames = static_cast<std::int32_t>(frames.size() + 1);
@@ -408,10 +391,11 @@ void XdmfResultWriter::Impl::write_frame_h5(const Frame& frame, const std::strin
 }
 
 void XdmfResultWriter::Impl::append_uniform_grid(std::ostringstream& x, const FrameRecord& fr,
-                                                 const GridBlock& block) const {
+                                                 ElementKind k) const {
   const std::size_t n_points = mesh.n_points();
-  const std::size_t n_cells = block.n_cells;
-  const std::string kind = block.kind;
+  const std::size_t n_cells = mesh.n_of(k);
+  const std::string kind = element_kind_name(k);
+  const ElementOutput out = element_output(k);
   const std::string h5name = kH5Name;
   auto data_item = [&](const std::string& dims, const char* number_type, int precision,
                        const std::string& path) {
@@ -424,9 +408,9 @@ void XdmfResultWriter::Impl::append_uniform_grid(std::ostringstream& x, const Fr
       << attribute_type(n_components) << "\" Center=\"" << (on_cells ? "Cell" : "Node") << "\">\n";
   };
 
-  x << "        <Grid Name=\"" << block.name << "\" GridType=\"Uniform\">\n";
-  x << "          <Topology " << block.topology << " NumberOfElements=\"" << n_cells << "\">\n";
-  data_item(std::to_string(n_cells) + " " + std::to_string(block.nodes_per_cell), "Int", 8,
+  x << "        <Grid Name=\"" << out.grid << "\" GridType=\"Uniform\">\n";
+  x << "          <Topology " << out.topology << " NumberOfElements=\"" << n_cells << "\">\n";
+  data_item(std::to_string(n_cells) + " " + std::to_string(nodes_per_element(k)), "Int", 8,
             "/mesh/" + kind);
   x << "          </Topology>\n";
   x << "          <Geometry GeometryType=\"XYZ\">\n";
@@ -434,7 +418,7 @@ void XdmfResultWriter::Impl::append_uniform_grid(std::ostringstream& x, const Fr
   x << "          </Geometry>\n";
 
   attribute("part_id", 1, true);
-  data_item(std::to_string(n_cells), "Int", 4, std::string("/mesh/") + block.part);
+  data_item(std::to_string(n_cells), "Int", 4, std::string("/mesh/") + out.part);
   x << "          </Attribute>\n";
   attribute("displacement", 3, false);
   data_item(std::to_string(n_points) + " 3", "Float", 8, fr.group + "/displacement");
@@ -463,13 +447,8 @@ std::string XdmfResultWriter::Impl::xdmf_text() const {
       << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
       << "        <Time Value=\"" << detail::format_double(fr.time) << "\"/>\n"
       << "        <Information Name=\"cycle\" Value=\"" << fr.cycle << "\"/>\n";
-    const GridBlock blocks[] = {
-        {"solids", "TopologyType=\"Hexahedron\"", 8, mesh.n_hex(), "hex8", "hex_part"},
-        {"bars", "TopologyType=\"Polyline\" NodesPerElement=\"2\"", 2, mesh.n_bar(), "bar2",
-         "bar_part"},
-        {"shells", "TopologyType=\"Quadrilateral\"", 4, mesh.n_quad(), "quad4", "quad_part"}};
-    for (const GridBlock& block : blocks) {
-      if (block.n_cells > 0) append_uniform_grid(x, fr, block);
+    for (ElementKind k : kElementKinds) {
+      if (mesh.n_of(k) > 0) append_uniform_grid(x, fr, k);
     }
     x << "      </Grid>\n";
   }

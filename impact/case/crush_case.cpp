@@ -194,10 +194,10 @@ void import_hexahedra(const TableReader& m, const fem::io::StageFrame& fr, NodeI
   for (const auto& name : rm.part_names) mesh.add_part(name);
   for (std::size_t h = 0; h < nh; ++h) {
     std::int32_t nodes[8];
-    for (std::size_t I = 0; I < 8; ++I) nodes[I] = node(rm.hex8[8 * h + I]);
-    hexes.add(std::span<const std::int32_t>(nodes, 8), rm.hex_part[h]);
-    hexes.user_id.push_back(rm.hex_user_id.empty() ? static_cast<std::int64_t>(h + 1)
-                                                   : rm.hex_user_id[h]);
+    for (std::size_t I = 0; I < 8; ++I) nodes[I] = node(rm.hex().conn[8 * h + I]);
+    hexes.add(std::span<const std::int32_t>(nodes, 8), rm.hex().part[h]);
+    hexes.user_id.push_back(rm.hex().user_id.empty() ? static_cast<std::int64_t>(h + 1)
+                                                     : rm.hex().user_id[h]);
     hexes.ply.push_back(rm.hex_ply.empty() ? -1 : rm.hex_ply[h]);
     hexes.tow.push_back(rm.hex_tow.empty() ? -1 : rm.hex_tow[h]);
     for (int r = 0; r < 3; ++r)
@@ -253,10 +253,10 @@ void import_stitches(const TableReader& m, const fem::io::StageFrame& fr, NodeIm
     fem::ElementSet& bars = mesh.elements(fem::ElementKind::Bar2);
     for (std::size_t b = 0; b < nb; ++b) {
       // Stitch nodes are new nodes, tied to the tows in assign_impregnated_parts.
-      const std::int32_t nodes[2] = {node(rm.bar2[2 * b]), node(rm.bar2[2 * b + 1])};
-      bars.add(std::span<const std::int32_t>(nodes, 2), rm.bar_part[b]);
-      bars.user_id.push_back(rm.bar_user_id.empty() ? static_cast<std::int64_t>(b + 1)
-                                                    : rm.bar_user_id[b]);
+      const std::int32_t nodes[2] = {node(rm.bars().conn[2 * b]), node(rm.bars().conn[2 * b + 1])};
+      bars.add(std::span<const std::int32_t>(nodes, 2), rm.bars().part[b]);
+      bars.user_id.push_back(rm.bars().user_id.empty() ? static_cast<std::int64_t>(b + 1)
+                                                       : rm.bars().user_id[b]);
     }
     for (std::size_t n = first_stitch_node; n < mesh.n_nodes(); ++n)
       im.stitch_nodes.push_back(static_cast<std::int32_t>(n));
@@ -313,8 +313,8 @@ ImpregnatedImport read_impregnated_model(CaseReadContext& ctx) {
   mesh.fill_default_user_ids();
   for (std::size_t p = 0; p < mesh.part_names.size(); ++p) {
     const auto& name = mesh.part_names[p];
-    const bool stitch = std::find(rm.bar_part.begin(), rm.bar_part.end(),
-                                  static_cast<std::int32_t>(p)) != rm.bar_part.end();
+    const bool stitch = std::find(rm.bars().part.begin(), rm.bars().part.end(),
+                                  static_cast<std::int32_t>(p)) != rm.bars().part.end();
     ctx.part_kind[name] = stitch ? fem::PartKind::Bar : fem::PartKind::Solid;
     ctx.generated_parts[name] =
         stitch ? "[model] (the transfer's kept stitches)" : "[model] (the transfer's plies)";

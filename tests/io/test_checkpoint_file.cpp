@@ -156,8 +156,8 @@ TEST(CheckpointFile, ResultsReopenedKeepTheFramesBeforeTheCheckpoint) {
   io::ResultMesh mesh;
   for (int k = 0; k < 8; ++k)
     mesh.points.insert(mesh.points.end(), {double(k & 1), double((k >> 1) & 1), double(k >> 2)});
-  mesh.hex8 = {0, 1, 3, 2, 4, 5, 7, 6};
-  mesh.hex_part = {0};
+  mesh.hex().conn = {0, 1, 3, 2, 4, 5, 7, 6};
+  mesh.hex().part = {0};
   mesh.part_names = {"cube"};
   auto frame = [](double t) {
     io::Frame f;
@@ -199,7 +199,7 @@ TEST(CheckpointFile, ResultsReopenedKeepTheFramesBeforeTheCheckpoint) {
   // Another mesh, or fewer frames than the checkpoint's, is refused.
   io::ResultMesh other = mesh;
   other.points.resize(21);
-  other.hex8 = {0, 1, 3, 2, 4, 5, 6, 6};
+  other.hex().conn = {0, 1, 3, 2, 4, 5, 6, 6};
   EXPECT_THROW(io::XdmfResultWriter::reopen(two, other, kept), std::runtime_error);
   kept.resize(6, kept.back());
   EXPECT_THROW(io::XdmfResultWriter::reopen(two, mesh, kept), std::runtime_error);

@@ -59,18 +59,19 @@ ResultMesh make_mesh(bool with_bars = true) {
   for (int k = 0; k < NZ; ++k)
     for (int j = 0; j < NY; ++j)
       for (int i = 0; i < NX; ++i) {
-        m.hex8.insert(m.hex8.end(), {node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k),
-                                     node(i, j + 1, k), node(i, j, k + 1), node(i + 1, j, k + 1),
-                                     node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1)});
-        m.hex_part.push_back(i < 2 ? 0 : 1);
+        m.hex().conn.insert(m.hex().conn.end(),
+                            {node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k),
+                             node(i, j + 1, k), node(i, j, k + 1), node(i + 1, j, k + 1),
+                             node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1)});
+        m.hex().part.push_back(i < 2 ? 0 : 1);
       }
   if (with_bars) {
     for (int i = 0; i < NX; ++i) {  // along x on the top front edge
-      m.bar2.insert(m.bar2.end(), {node(i, 0, NZ), node(i + 1, 0, NZ)});
-      m.bar_part.push_back(2);
+      m.bars().conn.insert(m.bars().conn.end(), {node(i, 0, NZ), node(i + 1, 0, NZ)});
+      m.bars().part.push_back(2);
     }
-    m.bar2.insert(m.bar2.end(), {node(NX, 0, NZ), node(NX, 1, NZ)});  // along y
-    m.bar_part.push_back(2);
+    m.bars().conn.insert(m.bars().conn.end(), {node(NX, 0, NZ), node(NX, 1, NZ)});  // along y
+    m.bars().part.push_back(2);
   }
   m.part_names = {"matrix", "insert", "tows"};
   return m;
@@ -82,9 +83,9 @@ constexpr std::size_t kQuads = NX * NY;  // shells on one face of the block
 void add_top_shells(ResultMesh& m, std::int32_t part) {
   for (int j = 0; j < NY; ++j)
     for (int i = 0; i < NX; ++i) {
-      m.quad4.insert(m.quad4.end(), {node(i, j, NZ), node(i + 1, j, NZ), node(i + 1, j + 1, NZ),
-                                     node(i, j + 1, NZ)});
-      m.quad_part.push_back(part);
+      m.shells().conn.insert(m.shells().conn.end(), {node(i, j, NZ), node(i + 1, j, NZ),
+                                                     node(i + 1, j + 1, NZ), node(i, j + 1, NZ)});
+      m.shells().part.push_back(part);
     }
 }
 
@@ -92,9 +93,9 @@ void add_top_shells(ResultMesh& m, std::int32_t part) {
 void add_bottom_shells(ResultMesh& m, std::int32_t part) {
   for (int j = 0; j < NY; ++j)
     for (int i = 0; i < NX; ++i) {
-      m.quad4.insert(m.quad4.end(),
-                     {node(i, j, 0), node(i, j + 1, 0), node(i + 1, j + 1, 0), node(i + 1, j, 0)});
-      m.quad_part.push_back(part);
+      m.shells().conn.insert(m.shells().conn.end(), {node(i, j, 0), node(i, j + 1, 0),
+                                                     node(i + 1, j + 1, 0), node(i + 1, j, 0)});
+      m.shells().part.push_back(part);
     }
 }
 
@@ -102,8 +103,8 @@ void add_bottom_shells(ResultMesh& m, std::int32_t part) {
 // thicknesses 1.0, 1.1, ... mm.
 void add_shell_handoff(ResultMesh& m, std::int32_t material) {
   for (std::size_t q = 0; q < m.n_quad(); ++q) {
-    m.quad_user_id.push_back(5001 + static_cast<std::int64_t>(q));
-    m.quad_material.push_back(q % 2 == 0 ? material : -1);
+    m.shells().user_id.push_back(5001 + static_cast<std::int64_t>(q));
+    m.shells().material.push_back(q % 2 == 0 ? material : -1);
     m.quad_thickness.push_back(1e-3 * (1.0 + 0.1 * static_cast<double>(q)));
   }
 }
@@ -122,8 +123,8 @@ ResultMesh make_mixed_mesh() {
 // (the middle layer of points belongs to no cell).
 ResultMesh make_shell_mesh() {
   ResultMesh m = make_mesh(/*with_bars=*/false);
-  m.hex8.clear();
-  m.hex_part.clear();
+  m.hex().conn.clear();
+  m.hex().part.clear();
   add_top_shells(m, 0);
   add_bottom_shells(m, 1);
   m.part_names = {"top", "bottom"};
@@ -492,9 +493,9 @@ void check_vtu_series(const fs::path& dir, const ResultMesh& mesh, int n_frames)
     const std::size_t nn = hex ? 8 : bar ? 2 : 4;
     ASSERT_EQ(static_cast<std::size_t>(ids->GetNumberOfIds()), nn);
     for (std::size_t j = 0; j < nn; ++j) {
-      const std::int64_t want = hex   ? mesh.hex8[8 * c + j]
-                                : bar ? mesh.bar2[2 * (c - first_bar) + j]
-                                      : mesh.quad4[4 * (c - first_quad) + j];
+      const std::int64_t want = hex   ? mesh.hex().conn[8 * c + j]
+                                : bar ? mesh.bars().conn[2 * (c - first_bar) + j]
+                                      : mesh.shells().conn[4 * (c - first_quad) + j];
       EXPECT_EQ(ids->GetId(static_cast<vtkIdType>(j)), want) << "cell " << c;
     }
   }
@@ -519,9 +520,9 @@ void check_vtu_series(const fs::path& dir, const ResultMesh& mesh, int n_frames)
   vtkDataArray* part = ug->GetCellData()->GetArray("part_id");
   ASSERT_TRUE(part);
   for (std::size_t c = 0; c < n_cells; ++c) {
-    const int want = c < first_bar    ? mesh.hex_part[c]
-                     : c < first_quad ? mesh.bar_part[c - first_bar]
-                                      : mesh.quad_part[c - first_quad];
+    const int want = c < first_bar    ? mesh.hex().part[c]
+                     : c < first_quad ? mesh.bars().part[c - first_bar]
+                                      : mesh.shells().part[c - first_quad];
     EXPECT_EQ(part->GetComponent(static_cast<vtkIdType>(c), 0), want);
   }
   vtkDataArray* stress = ug->GetCellData()->GetArray("stress");
@@ -562,10 +563,11 @@ TEST(XdmfResultWriter, H5HoldsMeshPartsAndFrames) {
   H5File h5(dir.path() / "results.h5");
   ASSERT_GE(h5.id, 0);
   EXPECT_EQ(read_dataset<double>(h5.id, "/mesh/points", H5T_NATIVE_DOUBLE), mesh.points);
-  EXPECT_EQ(read_dataset<std::int64_t>(h5.id, "/mesh/hex8", H5T_NATIVE_INT64), mesh.hex8);
-  EXPECT_EQ(read_dataset<std::int64_t>(h5.id, "/mesh/bar2", H5T_NATIVE_INT64), mesh.bar2);
-  EXPECT_EQ(read_dataset<std::int32_t>(h5.id, "/mesh/hex_part", H5T_NATIVE_INT32), mesh.hex_part);
-  EXPECT_EQ(read_dataset<std::int32_t>(h5.id, "/mesh/bar_part", H5T_NATIVE_INT32), mesh.bar_part);
+  EXPECT_EQ(read_dataset<std::int64_t>(h5.id, "/mesh/hex8", H5T_NATIVE_INT64), mesh.hex().conn);
+  EXPECT_EQ(read_dataset<std::int64_t>(h5.id, "/mesh/bar2", H5T_NATIVE_INT64), mesh.bars().conn);
+  EXPECT_EQ(read_dataset<std::int32_t>(h5.id, "/mesh/hex_part", H5T_NATIVE_INT32), mesh.hex().part);
+  EXPECT_EQ(read_dataset<std::int32_t>(h5.id, "/mesh/bar_part", H5T_NATIVE_INT32),
+            mesh.bars().part);
   EXPECT_EQ(*dataset_dims(h5.id, "/mesh/points"), (std::vector<hsize_t>{kPoints, 3}));
   EXPECT_EQ(*dataset_dims(h5.id, "/mesh/hex8"), (std::vector<hsize_t>{kHex, 8}));
   EXPECT_EQ(*dataset_dims(h5.id, "/mesh/bar2"), (std::vector<hsize_t>{kBars, 2}));
@@ -707,10 +709,10 @@ TEST(Consistency, NewWriterReplacesEarlierSeries) {
 TEST(Errors, BadInputIsRejected) {
   TempDir dir;
   ResultMesh bad = make_mesh();
-  bad.hex8[3] = 999;
+  bad.hex().conn[3] = 999;
   EXPECT_THROW(XdmfResultWriter(dir.path(), bad), std::invalid_argument);
   bad = make_mesh();
-  bad.bar_part.pop_back();
+  bad.bars().part.pop_back();
   EXPECT_THROW(VtuSeriesWriter(dir.path(), bad), std::invalid_argument);
 
   const ResultMesh mesh = make_mesh();
@@ -813,21 +815,21 @@ void check_read_back(const fs::path& h5, const ResultMesh& mesh, int n_frames) {
   EXPECT_EQ(r.n_bar(), mesh.n_bar());
   EXPECT_EQ(r.n_quad(), mesh.n_quad());
   EXPECT_EQ(r.points, mesh.points);
-  EXPECT_EQ(r.hex8, mesh.hex8);
-  EXPECT_EQ(r.bar2, mesh.bar2);
-  EXPECT_EQ(r.quad4, mesh.quad4);
-  EXPECT_EQ(r.hex_part, mesh.hex_part);
-  EXPECT_EQ(r.bar_part, mesh.bar_part);
-  EXPECT_EQ(r.quad_part, mesh.quad_part);
-  EXPECT_EQ(r.quad_user_id, mesh.quad_user_id);
-  EXPECT_EQ(r.quad_material, mesh.quad_material);
+  EXPECT_EQ(r.hex().conn, mesh.hex().conn);
+  EXPECT_EQ(r.bars().conn, mesh.bars().conn);
+  EXPECT_EQ(r.shells().conn, mesh.shells().conn);
+  EXPECT_EQ(r.hex().part, mesh.hex().part);
+  EXPECT_EQ(r.bars().part, mesh.bars().part);
+  EXPECT_EQ(r.shells().part, mesh.shells().part);
+  EXPECT_EQ(r.shells().user_id, mesh.shells().user_id);
+  EXPECT_EQ(r.shells().material, mesh.shells().material);
   EXPECT_EQ(r.quad_thickness, mesh.quad_thickness);  // float64 both ways: bitwise
   EXPECT_EQ(r.part_names, mesh.part_names);
   EXPECT_EQ(r.material_names, mesh.material_names);
 
   const StageFrame last = read_last_frame(h5);
   EXPECT_EQ(last.index, static_cast<std::size_t>(n_frames - 1));
-  EXPECT_EQ(last.mesh.quad4, mesh.quad4);
+  EXPECT_EQ(last.mesh.shells().conn, mesh.shells().conn);
   EXPECT_EQ(last.mesh.quad_thickness, mesh.quad_thickness);
   const Frame written = make_frame(mesh, n_frames - 1);
   for (const FrameField& w : written.fields) {
@@ -858,13 +860,14 @@ TEST(Shells, MixedMeshWritesQuadCellsBesideHexesAndBarsAndReadsBack) {
     H5File h5(dir.path() / "results.h5");
     ASSERT_GE(h5.id, 0);
     EXPECT_EQ(*dataset_dims(h5.id, "/mesh/quad4"), (std::vector<hsize_t>{kQuads, 4}));
-    EXPECT_EQ(read_dataset<std::int64_t>(h5.id, "/mesh/quad4", H5T_NATIVE_INT64), mesh.quad4);
+    EXPECT_EQ(read_dataset<std::int64_t>(h5.id, "/mesh/quad4", H5T_NATIVE_INT64),
+              mesh.shells().conn);
     EXPECT_EQ(read_dataset<std::int32_t>(h5.id, "/mesh/quad_part", H5T_NATIVE_INT32),
-              mesh.quad_part);
+              mesh.shells().part);
     EXPECT_EQ(read_dataset<std::int64_t>(h5.id, "/mesh/quad_user_id", H5T_NATIVE_INT64),
-              mesh.quad_user_id);
+              mesh.shells().user_id);
     EXPECT_EQ(read_dataset<std::int32_t>(h5.id, "/mesh/quad_material", H5T_NATIVE_INT32),
-              mesh.quad_material);
+              mesh.shells().material);
     EXPECT_EQ(read_dataset<double>(h5.id, "/mesh/quad_thickness", H5T_NATIVE_DOUBLE),
               mesh.quad_thickness);
     EXPECT_EQ(read_attribute<std::int32_t>(h5.id, "/", "format_version", H5T_NATIVE_INT32), 2);
@@ -951,8 +954,8 @@ TEST(Shells, ShellsOnlyMesh) {
 TEST(Shells, FilesWithoutShellsKeepTheirLayout) {
   TempDir dir;
   ResultMesh mesh = make_mesh();
-  mesh.hex_user_id.resize(mesh.n_hex(), 7);
-  mesh.hex_material.resize(mesh.n_hex(), 0);
+  mesh.hex().user_id.resize(mesh.n_hex(), 7);
+  mesh.hex().material.resize(mesh.n_hex(), 0);
   mesh.material_names = {"resin"};
   {
     XdmfResultWriter writer(dir.path(), mesh);
@@ -992,8 +995,8 @@ TEST(Shells, FilesWithoutShellsKeepTheirLayout) {
 
   const StageFrame fr = read_last_frame(dir.path() / "results.h5");
   EXPECT_EQ(fr.mesh.n_quad(), 0u);
-  EXPECT_TRUE(fr.mesh.quad_part.empty() && fr.mesh.quad_user_id.empty() &&
-              fr.mesh.quad_material.empty() && fr.mesh.quad_thickness.empty());
+  EXPECT_TRUE(fr.mesh.shells().part.empty() && fr.mesh.shells().user_id.empty() &&
+              fr.mesh.shells().material.empty() && fr.mesh.quad_thickness.empty());
   ASSERT_TRUE(fr.field("stress"));
   EXPECT_EQ(fr.field("stress")->values.size(), 6 * kCells);
 }
@@ -1008,10 +1011,10 @@ TEST(Shells, XdmfTextWithoutShellsIsUnchanged) {
     for (int j = 0; j < 2; ++j)
       for (int i = 0; i < 2; ++i)
         mesh.points.insert(mesh.points.end(), {1.0 * i, 1.0 * j, 1.0 * k});
-  mesh.hex8 = {0, 1, 3, 2, 4, 5, 7, 6};
-  mesh.hex_part = {0};
-  mesh.bar2 = {0, 7};
-  mesh.bar_part = {1};
+  mesh.hex().conn = {0, 1, 3, 2, 4, 5, 7, 6};
+  mesh.hex().part = {0};
+  mesh.bars().conn = {0, 7};
+  mesh.bars().part = {1};
   mesh.part_names = {"block", "tie"};
   Frame fr;
   fr.time = 0.5;
@@ -1079,31 +1082,31 @@ TEST(Shells, BadShellInputIsRejected) {
     }
   };
   ResultMesh m = good;
-  m.quad4.pop_back();
+  m.shells().conn.pop_back();
   rejected(m, "quad4 has 23 node ids, not a multiple of 4");
   m = good;
-  m.quad4[9] = static_cast<std::int64_t>(kPoints);
+  m.shells().conn[9] = static_cast<std::int64_t>(kPoints);
   rejected(m, "shell 2 has node id 36 outside [0, 36)");
   m = good;
-  m.quad4[0] = -1;
+  m.shells().conn[0] = -1;
   rejected(m, "shell 0 has node id -1");
   m = good;
-  m.quad_part.pop_back();
+  m.shells().part.pop_back();
   rejected(m, "quad_part has 5 entries for 6 shells");
   m = good;
-  m.quad_part[4] = -2;
+  m.shells().part[4] = -2;
   rejected(m, "shell 4 has negative part id -2");
   m = good;
-  m.quad_user_id.pop_back();
+  m.shells().user_id.pop_back();
   rejected(m, "quad_user_id has 5 entries for 6 shells");
   m = good;
-  m.quad_material.push_back(0);
+  m.shells().material.push_back(0);
   rejected(m, "quad_material has 7 entries for 6 shells");
   m = good;
-  m.quad_material[3] = 2;  // two material names
+  m.shells().material[3] = 2;  // two material names
   rejected(m, "shell 3 has material index 2, allowed -1 (none) or [0, 2)");
   m = good;
-  m.quad_material[3] = -5;
+  m.shells().material[3] = -5;
   rejected(m, "shell 3 has material index -5");
   m = good;
   m.quad_thickness.resize(2);
@@ -1115,12 +1118,12 @@ TEST(Shells, BadShellInputIsRejected) {
   m.quad_thickness[1] = std::numeric_limits<double>::quiet_NaN();
   rejected(m, "shell 1 has thickness NaN m");
   m = good;  // the optional arrays may be left out
-  m.quad_user_id.clear(), m.quad_material.clear(), m.quad_thickness.clear();
+  m.shells().user_id.clear(), m.shells().material.clear(), m.quad_thickness.clear();
   EXPECT_NO_THROW(validate_mesh(m));
 
   TempDir dir;
   m = good;
-  m.quad_part.clear();
+  m.shells().part.clear();
   EXPECT_THROW(XdmfResultWriter(dir.path(), m), std::invalid_argument);
   EXPECT_THROW(VtuSeriesWriter(dir.path(), m), std::invalid_argument);
 
@@ -1189,7 +1192,8 @@ TEST(Shells, ReaderRefusesDamagedShellDatasets) {
     const hid_t space = H5Screate_simple(2, dims, nullptr);
     const hid_t d =
         H5Dcreate2(f, "/mesh/quad4", H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    ASSERT_GE(H5Dwrite(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, mesh.quad4.data()), 0);
+    ASSERT_GE(
+        H5Dwrite(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, mesh.shells().conn.data()), 0);
     H5Dclose(d);
     H5Sclose(space);
     H5Fclose(f);

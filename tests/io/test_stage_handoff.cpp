@@ -105,8 +105,8 @@ TEST(StageHandoff, LastFrameRebuildsTheFabricModel) {
   EXPECT_EQ(original.size(), mesh.n_elements()) << "user ids are unique per kind";
   EXPECT_TRUE(original == again);
   for (std::size_t e = 0; e < fr.mesh.n_hex(); ++e)  // the material per element as stored
-    EXPECT_EQ(fr.mesh.hex_material[e],
-              ec.model.parts[static_cast<std::size_t>(fr.mesh.hex_part[e])].material);
+    EXPECT_EQ(fr.mesh.hex().material[e],
+              ec.model.parts[static_cast<std::size_t>(fr.mesh.hex().part[e])].material);
   std::set<std::pair<int, int>> tows, tows_again;
   const auto& hexes = mesh.elements(fem::ElementKind::Hex8);
   const auto& hexes_again = rebuilt.elements(fem::ElementKind::Hex8);
@@ -148,7 +148,7 @@ TEST(StageHandoff, FramesByIndexAndTime) {
   EXPECT_TRUE(fr.mesh.hex_tow.empty() ||
               fr.mesh.hex_tow == std::vector<std::int32_t>(fr.mesh.n_hex(), -1))
       << "no fabric: no tows";
-  EXPECT_EQ(fr.mesh.hex_user_id.size(), fr.mesh.n_hex());
+  EXPECT_EQ(fr.mesh.hex().user_id.size(), fr.mesh.n_hex());
   fs::remove_all(dir);
 }
 
@@ -177,12 +177,12 @@ TEST(StageRegistry, UnknownKindNamesTheAllowedOnes) {
 TEST(StageHandoff, OptionalIdsAreEmptyOrOnePerElement) {
   fem::io::ResultMesh m;
   m.points = {0, 0, 0, 1, 0, 0};
-  m.bar2 = {0, 1};
-  m.bar_part = {0};
+  m.bars().conn = {0, 1};
+  m.bars().part = {0};
   EXPECT_NO_THROW(fem::io::validate_mesh(m));  // no hand-off ids: an older writer's mesh
-  m.bar_user_id = {7, 8};
+  m.bars().user_id = {7, 8};
   EXPECT_THROW(fem::io::validate_mesh(m), std::invalid_argument);
-  m.bar_user_id = {7};
+  m.bars().user_id = {7};
   m.node_user_id = {1};
   EXPECT_THROW(fem::io::validate_mesh(m), std::invalid_argument);
   m.node_user_id = {1, 2};

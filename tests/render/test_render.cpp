@@ -29,6 +29,7 @@
 
 namespace fs = std::filesystem;
 using namespace ncfsim::render;
+namespace fem = ncfsim::fem;
 
 namespace {
 
@@ -118,9 +119,10 @@ RenderMesh slab(int n_x, int n_y)
   MeshField temperature{"temperature", "K", true, 1, {}};
   for (int j = 0; j < n_y; ++j) {
     for (int i = 0; i < n_x; ++i) {
-      mesh.hex8.insert(mesh.hex8.end(), {node(i, j, 0), node(i + 1, j, 0), node(i + 1, j + 1, 0),
-                                         node(i, j + 1, 0), node(i, j, 1), node(i + 1, j, 1),
-                                         node(i + 1, j + 1, 1), node(i, j + 1, 1)});
+      mesh.of(fem::ElementKind::Hex8)
+          .insert(mesh.of(fem::ElementKind::Hex8).end(),
+                  {node(i, j, 0), node(i + 1, j, 0), node(i + 1, j + 1, 0), node(i, j + 1, 0),
+                   node(i, j, 1), node(i + 1, j, 1), node(i + 1, j + 1, 1), node(i, j + 1, 1)});
       temperature.values.push_back(i + 0.5);
     }
   }
@@ -236,7 +238,8 @@ TEST(Render, IsoAndFrontViewsWithBarsAndPointField)
     mesh.points.insert(mesh.points.end(), {7.0 + i, 0.0, 0.0, 7.0 + i, 4.0, 1.0});
   }
   for (int i = 0; i <= 3; ++i) {
-    mesh.bar2.insert(mesh.bar2.end(), {first + 2 * i, first + 2 * i + 1});
+    mesh.of(fem::ElementKind::Bar2)
+        .insert(mesh.of(fem::ElementKind::Bar2).end(), {first + 2 * i, first + 2 * i + 1});
   }
   const std::size_t n_points = mesh.points.size() / 3;
   for (auto& f : mesh.fields) {
@@ -491,7 +494,7 @@ TEST(Render, UnknownFieldThrowsWithTheNames)
 TEST(Render, BadInputThrows)
 {
   RenderMesh bad = slab(2, 2);
-  bad.hex8[3] = 1000; // node id out of range
+  bad.of(fem::ElementKind::Hex8)[3] = 1000;  // node id out of range
   MeshFigure figure;
   figure.field = "temperature";
   EXPECT_THROW(render_mesh_png(bad, figure, output_dir() / "never.png"), std::runtime_error);
@@ -517,7 +520,7 @@ TEST(Render, BadInputThrows)
 // cells renders (a gap down the middle).
 TEST(Render, WithoutHexesDropsTheCellsAndTheirValues) {
   RenderMesh mesh = slab(3, 2);
-  mesh.bar2 = {0, 3};
+  mesh.of(fem::ElementKind::Bar2) = {0, 3};
   MeshField stress{"stress", "Pa", true, 2, {}};
   for (int c = 0; c < 6; ++c) {
     stress.values.insert(stress.values.end(), {double(c), 10.0 * c});
@@ -527,11 +530,13 @@ TEST(Render, WithoutHexesDropsTheCellsAndTheirValues) {
   mesh.fields.push_back(stress);
   const std::vector<char> drop{0, 1, 0, 0, 1, 0};
   const RenderMesh kept = without_hexes(mesh, drop);
-  ASSERT_EQ(kept.hex8.size(), 4u * 8u);
-  EXPECT_EQ(std::vector<std::int64_t>(kept.hex8.begin() + 8, kept.hex8.begin() + 16),
-            std::vector<std::int64_t>(mesh.hex8.begin() + 16, mesh.hex8.begin() + 24));
+  ASSERT_EQ(kept.of(fem::ElementKind::Hex8).size(), 4u * 8u);
+  EXPECT_EQ(std::vector<std::int64_t>(kept.of(fem::ElementKind::Hex8).begin() + 8,
+                                      kept.of(fem::ElementKind::Hex8).begin() + 16),
+            std::vector<std::int64_t>(mesh.of(fem::ElementKind::Hex8).begin() + 16,
+                                      mesh.of(fem::ElementKind::Hex8).begin() + 24));
   EXPECT_EQ(kept.points, mesh.points);
-  EXPECT_EQ(kept.bar2, mesh.bar2);
+  EXPECT_EQ(kept.of(fem::ElementKind::Bar2), mesh.of(fem::ElementKind::Bar2));
   ASSERT_EQ(kept.fields.size(), 3u);
   EXPECT_EQ(kept.fields[0].values, (std::vector<double>{0.5, 2.5, 0.5, 2.5, 7.0}));
   EXPECT_EQ(kept.fields[1].values, mesh.fields[1].values);  // on the points
@@ -560,15 +565,17 @@ std::size_t add_plate(RenderMesh& mesh, int n_x, int n_y, double x0, double z0,
       mesh.points.insert(mesh.points.end(), {x0 + i, double(j), z0});
     }
   }
-  const std::size_t first_shell = mesh.quad4.size() / 4;
+  const std::size_t first_shell = mesh.of(fem::ElementKind::Quad4).size() / 4;
   for (int j = 0; j < n_y; ++j) {
     for (int i = 0; i < n_x; ++i) {
       if (flipped) {
-        mesh.quad4.insert(mesh.quad4.end(),
-                          {node(i, j), node(i, j + 1), node(i + 1, j + 1), node(i + 1, j)});
+        mesh.of(fem::ElementKind::Quad4)
+            .insert(mesh.of(fem::ElementKind::Quad4).end(),
+                    {node(i, j), node(i, j + 1), node(i + 1, j + 1), node(i + 1, j)});
       } else {
-        mesh.quad4.insert(mesh.quad4.end(),
-                          {node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)});
+        mesh.of(fem::ElementKind::Quad4)
+            .insert(mesh.of(fem::ElementKind::Quad4).end(),
+                    {node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)});
       }
     }
   }
@@ -618,7 +625,7 @@ TEST(Render, ShellsOnlyPlateColouredByCellField)
   for (const bool flipped : {false, true}) {
     RenderMesh mesh;
     add_plate(mesh, 10, 10, 0.0, 0.0, flipped);
-    ASSERT_TRUE(mesh.hex8.empty() && mesh.bar2.empty());
+    ASSERT_TRUE(mesh.of(fem::ElementKind::Hex8).empty() && mesh.of(fem::ElementKind::Bar2).empty());
     MeshField shear{"shear_angle_deg", "deg", true, 1, {}};
     MeshField membrane{"membrane_force", "N/m", true, 3, {}};
     for (int j = 0; j < 10; ++j) {
@@ -673,10 +680,11 @@ TEST(Render, MixedHexBarShellMesh)
   RenderMesh mesh = slab(4, 4);
   mesh.fields.clear();
   add_plate(mesh, 4, 4, 5.0, 0.5);
-  mesh.bar2 = {static_cast<std::int64_t>(4 * 5 + 4 + 25), // slab top corner (4, 4, 1) ..
-               static_cast<std::int64_t>(50)};            // .. first plate node (5, 0, 0.5)
-  ASSERT_EQ(mesh.hex8.size() / 8, 16u);
-  ASSERT_EQ(mesh.quad4.size() / 4, 16u);
+  mesh.of(fem::ElementKind::Bar2) = {
+      static_cast<std::int64_t>(4 * 5 + 4 + 25),  // slab top corner (4, 4, 1) ..
+      static_cast<std::int64_t>(50)};             // .. first plate node (5, 0, 0.5)
+  ASSERT_EQ(mesh.of(fem::ElementKind::Hex8).size() / 8, 16u);
+  ASSERT_EQ(mesh.of(fem::ElementKind::Quad4).size() / 4, 16u);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   MeshField value{"value", "-", true, 1, {}};
   MeshField hex_only{"von_mises_stress", "Pa", true, 1, {}};
@@ -738,10 +746,10 @@ TEST(Render, MixedHexBarShellMesh)
     EXPECT_NE(std::string(e.what()).find("expected 33 cells"), std::string::npos) << e.what();
   }
   RenderMesh bad = mesh;
-  bad.quad4.pop_back();
+  bad.of(fem::ElementKind::Quad4).pop_back();
   EXPECT_THROW(render_mesh_png(bad, figure, output_dir() / "never.png"), std::runtime_error);
   bad = mesh;
-  bad.quad4[5] = -1;
+  bad.of(fem::ElementKind::Quad4)[5] = -1;
   EXPECT_THROW(render_mesh_png(bad, figure, output_dir() / "never.png"), std::runtime_error);
   EXPECT_FALSE(fs::exists(output_dir() / "never.png"));
 }
@@ -753,26 +761,32 @@ TEST(Render, WithoutCellsDropsShellsToo)
   RenderMesh mesh = slab(2, 1);
   mesh.fields.clear();
   add_plate(mesh, 3, 1, 3.0, 0.0);
-  mesh.bar2 = {0, 1};
+  mesh.of(fem::ElementKind::Bar2) = {0, 1};
   MeshField f{"f", "-", true, 2, {}};
   for (int c = 0; c < 6; ++c) { // 2 hexes, 1 bar, 3 shells
     f.values.insert(f.values.end(), {double(c), -double(c)});
   }
   mesh.fields = {f};
   const RenderMesh kept = without_cells(mesh, {1, 0, 1, 0, 1, 0});
-  EXPECT_EQ(kept.hex8, std::vector<std::int64_t>(mesh.hex8.begin() + 8, mesh.hex8.end()));
-  EXPECT_TRUE(kept.bar2.empty());
-  ASSERT_EQ(kept.quad4.size(), 8u);
-  EXPECT_EQ(std::vector<std::int64_t>(kept.quad4.begin(), kept.quad4.begin() + 4),
-            std::vector<std::int64_t>(mesh.quad4.begin(), mesh.quad4.begin() + 4));
-  EXPECT_EQ(std::vector<std::int64_t>(kept.quad4.begin() + 4, kept.quad4.end()),
-            std::vector<std::int64_t>(mesh.quad4.begin() + 8, mesh.quad4.end()));
+  EXPECT_EQ(kept.of(fem::ElementKind::Hex8),
+            std::vector<std::int64_t>(mesh.of(fem::ElementKind::Hex8).begin() + 8,
+                                      mesh.of(fem::ElementKind::Hex8).end()));
+  EXPECT_TRUE(kept.of(fem::ElementKind::Bar2).empty());
+  ASSERT_EQ(kept.of(fem::ElementKind::Quad4).size(), 8u);
+  EXPECT_EQ(std::vector<std::int64_t>(kept.of(fem::ElementKind::Quad4).begin(),
+                                      kept.of(fem::ElementKind::Quad4).begin() + 4),
+            std::vector<std::int64_t>(mesh.of(fem::ElementKind::Quad4).begin(),
+                                      mesh.of(fem::ElementKind::Quad4).begin() + 4));
+  EXPECT_EQ(std::vector<std::int64_t>(kept.of(fem::ElementKind::Quad4).begin() + 4,
+                                      kept.of(fem::ElementKind::Quad4).end()),
+            std::vector<std::int64_t>(mesh.of(fem::ElementKind::Quad4).begin() + 8,
+                                      mesh.of(fem::ElementKind::Quad4).end()));
   EXPECT_EQ(kept.fields[0].values, (std::vector<double>{1, -1, 3, -3, 5, -5}));
   EXPECT_THROW(without_cells(mesh, {0, 0, 0}), std::invalid_argument);
 
   const RenderMesh no_hex = without_hexes(mesh, {1, 1});
-  EXPECT_TRUE(no_hex.hex8.empty());
-  EXPECT_EQ(no_hex.bar2, mesh.bar2);
-  EXPECT_EQ(no_hex.quad4, mesh.quad4);
+  EXPECT_TRUE(no_hex.of(fem::ElementKind::Hex8).empty());
+  EXPECT_EQ(no_hex.of(fem::ElementKind::Bar2), mesh.of(fem::ElementKind::Bar2));
+  EXPECT_EQ(no_hex.of(fem::ElementKind::Quad4), mesh.of(fem::ElementKind::Quad4));
   EXPECT_EQ(no_hex.fields[0].values, (std::vector<double>{2, -2, 3, -3, 4, -4, 5, -5}));
 }

@@ -166,7 +166,7 @@ TEST(CliRegressionHemisphereDrape, CiMeshFormsToFullDepthQuasiStatically) {
       ASSERT_NEAR(fem::dot(fem::cross(u, v), w), 1.0, 1e-9) << e;
       std::array<fem::V3, 8> x;
       for (std::size_t a = 0; a < 8; ++a) {
-        const auto n = static_cast<std::size_t>(model.mesh.hex8[8 * e + a]);
+        const auto n = static_cast<std::size_t>(model.mesh.hex().conn[8 * e + a]);
         x[a] = fem::V3{model.coordinates[3 * n], model.coordinates[3 * n + 1],
                        model.coordinates[3 * n + 2]};
       }

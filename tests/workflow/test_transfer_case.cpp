@@ -130,23 +130,25 @@ TEST(CliTransfer, KeptStitchesBecomeBarsBetweenTowNodes) {
   ASSERT_EQ(model.mesh.n_bar(), kept);
   ASSERT_EQ(model.mesh.n_hex(), hexes);
   std::vector<char> hex_node(model.n_points(), 0);
-  for (auto n : model.mesh.hex8) hex_node[static_cast<std::size_t>(n)] = 1;
+  for (auto n : model.mesh.hex().conn) hex_node[static_cast<std::size_t>(n)] = 1;
   auto length = [](const fem::io::StageFrame& fr, std::size_t b) {
     double d2 = 0;
     for (std::size_t c = 0; c < 3; ++c) {
-      const double d = fr.coordinates[3 * static_cast<std::size_t>(fr.mesh.bar2[2 * b + 1]) + c] -
-                       fr.coordinates[3 * static_cast<std::size_t>(fr.mesh.bar2[2 * b]) + c];
+      const double d =
+          fr.coordinates[3 * static_cast<std::size_t>(fr.mesh.bars().conn[2 * b + 1]) + c] -
+          fr.coordinates[3 * static_cast<std::size_t>(fr.mesh.bars().conn[2 * b]) + c];
       d2 += d * d;
     }
     return std::sqrt(d2);
   };
   std::map<std::int64_t, std::size_t> source_bar;
-  for (std::size_t b = 0; b < source.mesh.n_bar(); ++b) source_bar[source.mesh.bar_user_id[b]] = b;
+  for (std::size_t b = 0; b < source.mesh.n_bar(); ++b)
+    source_bar[source.mesh.bars().user_id[b]] = b;
   for (std::size_t b = 0; b < kept; ++b) {
-    EXPECT_FALSE(hex_node[static_cast<std::size_t>(model.mesh.bar2[2 * b])] ||
-                 hex_node[static_cast<std::size_t>(model.mesh.bar2[2 * b + 1])])
+    EXPECT_FALSE(hex_node[static_cast<std::size_t>(model.mesh.bars().conn[2 * b])] ||
+                 hex_node[static_cast<std::size_t>(model.mesh.bars().conn[2 * b + 1])])
         << "bar " << b << ": the stitch nodes stay nodes of their own";
-    const auto it = source_bar.find(model.mesh.bar_user_id[b]);
+    const auto it = source_bar.find(model.mesh.bars().user_id[b]);
     ASSERT_NE(it, source_bar.end()) << "bar " << b << " is no stitch of the drape";
     EXPECT_NEAR(length(model, b), length(source, it->second), 1e-12) << b;
   }

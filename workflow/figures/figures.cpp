@@ -204,9 +204,7 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
       const auto frame = reader.frame(reader.n_frames() - 1);
       const auto& m = reader.mesh();
       render::RenderMesh rm;
-      rm.hex8 = m.hex8;
-      rm.bar2 = m.bar2;
-      rm.quad4 = m.quad4;
+      for (fem::ElementKind k : fem::kElementKinds) rm.of(k) = m.of(k).conn;
       for (const auto& f : frame.fields) {
         if (f.name == "displacement") {
           render::MeshField mag{"displacement_magnitude", "m", false, 1, {}};
@@ -256,16 +254,14 @@ std::vector<std::filesystem::path> render_figures(const std::filesystem::path& d
                 b[2 * c] = std::min(b[2 * c], v), b[2 * c + 1] = std::max(b[2 * c + 1], v);
               }
             };
-            for (std::size_t e = 0; e < m.hex_part.size(); ++e)
-              if (m.hex_part[e] == part && !eroded[e])
-                for (int I = 0; I < 8; ++I) grow(m.hex8[8 * e + static_cast<std::size_t>(I)]);
-            const std::size_t n_hex = m.n_hex(), n_bar = m.n_bar();
-            for (std::size_t e = 0; e < m.bar_part.size(); ++e)
-              if (m.bar_part[e] == part && !eroded[n_hex + e])
-                grow(m.bar2[2 * e]), grow(m.bar2[2 * e + 1]);
-            for (std::size_t e = 0; e < m.quad_part.size(); ++e)
-              if (m.quad_part[e] == part && !eroded[n_hex + n_bar + e])
-                for (std::size_t I = 0; I < 4; ++I) grow(m.quad4[4 * e + I]);
+            for (fem::ElementKind k : fem::kElementKinds) {
+              const auto& c = m.of(k);
+              const auto nodes = static_cast<std::size_t>(fem::nodes_per_element(k));
+              const std::size_t first = m.first_cell(k);
+              for (std::size_t e = 0; e < c.part.size(); ++e)
+                if (c.part[e] == part && !eroded[first + e])
+                  for (std::size_t I = 0; I < nodes; ++I) grow(c.conn[nodes * e + I]);
+            }
             if (b[0] <= b[1]) fig.focus_bounds = b;
           }
           fig.title = p.at("title").get<std::string>() + " (t = " + fmt_time(frame.time) + " s" +

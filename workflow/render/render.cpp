@@ -299,33 +299,25 @@ void validate_mesh(const RenderMesh& mesh, const std::string& where) {
     fail(where, "points must hold 3 coordinates per node and at least one node, got " +
                     std::to_string(mesh.points.size()) + " values");
   }
-  if (mesh.hex8.size() % 8 != 0) {
-    fail(where, "hex8 must hold 8 node ids per hexahedron, got " +
-                    std::to_string(mesh.hex8.size()) + " ids");
-  }
-  if (mesh.bar2.size() % 2 != 0) {
-    fail(where,
-         "bar2 must hold 2 node ids per bar, got " + std::to_string(mesh.bar2.size()) + " ids");
-  }
-  if (mesh.quad4.size() % 4 != 0) {
-    fail(where,
-         "quad4 must hold 4 node ids per shell, got " + std::to_string(mesh.quad4.size()) + " ids");
-  }
-  if (mesh.hex8.empty() && mesh.bar2.empty() && mesh.quad4.empty()) {
-    fail(where, "the mesh has no hexahedra, no bars and no shells");
-  }
   const auto n_points = static_cast<std::int64_t>(mesh.points.size() / 3);
-  auto check_ids = [&](const std::vector<std::int64_t>& ids, const char* what) {
+  for (fem::ElementKind k : fem::kElementKinds) {
+    const auto& ids = mesh.of(k);
+    const std::string name = fem::element_kind_name(k);
+    const int nodes = fem::nodes_per_element(k);
+    if (ids.size() % static_cast<std::size_t>(nodes) != 0) {
+      fail(where, name + " must hold " + std::to_string(nodes) + " node ids per " +
+                      fem::element_noun(k) + ", got " + std::to_string(ids.size()) + " ids");
+    }
     for (std::size_t i = 0; i < ids.size(); ++i) {
       if (ids[i] < 0 || ids[i] >= n_points) {
-        fail(where, std::string(what) + " entry " + std::to_string(i) + " is node id " +
-                        std::to_string(ids[i]) + ", outside [0, " + std::to_string(n_points) + ")");
+        fail(where, name + " entry " + std::to_string(i) + " is node id " + std::to_string(ids[i]) +
+                        ", outside [0, " + std::to_string(n_points) + ")");
       }
     }
-  };
-  check_ids(mesh.hex8, "hex8");
-  check_ids(mesh.bar2, "bar2");
-  check_ids(mesh.quad4, "quad4");
+  }
+  if (mesh.n_cells() == 0) {
+    fail(where, "the mesh has no hexahedra, no bars and no shells");
+  }
   for (double c : mesh.points) {
     if (!std::isfinite(c)) {
       fail(where, "a node coordinate is not finite");
@@ -364,9 +356,7 @@ Scalars select_scalars(const RenderMesh& mesh, const MeshFigure& figure, const s
     fail(where, "component " + std::to_string(figure.component) + " of field '" + field->name +
                     "' out of range [-1, " + std::to_string(n_comp - 1) + "]");
   }
-  const std::size_t n_entities =
-      field->on_cells ? mesh.hex8.size() / 8 + mesh.bar2.size() / 2 + mesh.quad4.size() / 4
-                      : mesh.points.size() / 3;
+  const std::size_t n_entities = field->on_cells ? mesh.n_cells() : mesh.points.size() / 3;
   if (field->values.size() != n_entities * static_cast<std::size_t>(n_comp)) {
     fail(where, "field '" + field->name + "' has " + std::to_string(field->values.size()) +
                     " values, expected " + std::to_string(n_entities) + " " +
@@ -552,26 +542,27 @@ BoundaryQuads boundary_quads(const std::vector<std::int64_t>& hex8) {
 }  // namespace
 
 RenderMesh without_cells(const RenderMesh& mesh, const std::vector<char>& drop) {
-  const std::size_t n_hex = mesh.hex8.size() / 8, n_bar = mesh.bar2.size() / 2,
-                    n_quad = mesh.quad4.size() / 4, n_cells = n_hex + n_bar + n_quad;
-  if (drop.size() != n_cells)
+  const std::size_t n_cells = mesh.n_cells();
+  if (drop.size() != n_cells) {
+    std::string counts;
+    for (fem::ElementKind k : fem::kElementKinds)
+      counts += (counts.empty() ? "" : ", ") + std::to_string(mesh.n_of(k)) + " " +
+                fem::element_plural(k);
     throw std::invalid_argument("without_cells: " + std::to_string(drop.size()) + " flags for " +
-                                std::to_string(n_cells) + " cells (" + std::to_string(n_hex) +
-                                " hexahedra, " + std::to_string(n_bar) + " bars, " +
-                                std::to_string(n_quad) + " shells)");
+                                std::to_string(n_cells) + " cells (" + counts + ")");
+  }
   RenderMesh out;
   out.points = mesh.points;
-  // Copies the kept cells of one kind, whose flags are drop[first .. first + count).
-  auto keep = [&](const std::vector<std::int64_t>& from, std::size_t n_nodes, std::size_t first,
-                  std::size_t count, std::vector<std::int64_t>& to) {
-    for (std::size_t e = 0; e < count; ++e)
+  // Each kind's kept cells, whose flags are drop[first .. first + count).
+  for (fem::ElementKind k : fem::kElementKinds) {
+    const auto& from = mesh.of(k);
+    const auto n_nodes = static_cast<std::size_t>(fem::nodes_per_element(k));
+    const std::size_t first = mesh.first_cell(k);
+    for (std::size_t e = 0; e < mesh.n_of(k); ++e)
       if (!drop[first + e])
-        to.insert(to.end(), from.begin() + static_cast<std::ptrdiff_t>(n_nodes * e),
-                  from.begin() + static_cast<std::ptrdiff_t>(n_nodes * (e + 1)));
-  };
-  keep(mesh.hex8, 8, 0, n_hex, out.hex8);
-  keep(mesh.bar2, 2, n_hex, n_bar, out.bar2);
-  keep(mesh.quad4, 4, n_hex + n_bar, n_quad, out.quad4);
+        out.of(k).insert(out.of(k).end(), from.begin() + static_cast<std::ptrdiff_t>(n_nodes * e),
+                         from.begin() + static_cast<std::ptrdiff_t>(n_nodes * (e + 1)));
+  }
   for (const auto& f : mesh.fields) {
     if (!f.on_cells) {
       out.fields.push_back(f);
@@ -590,12 +581,12 @@ RenderMesh without_cells(const RenderMesh& mesh, const std::vector<char>& drop) 
 }
 
 RenderMesh without_hexes(const RenderMesh& mesh, const std::vector<char>& drop) {
-  const std::size_t n_hex = mesh.hex8.size() / 8;
+  const std::size_t n_hex = mesh.n_of(fem::ElementKind::Hex8);
   if (drop.size() != n_hex)
     throw std::invalid_argument("without_hexes: " + std::to_string(drop.size()) + " flags for " +
                                 std::to_string(n_hex) + " hexahedra");
   std::vector<char> cells(drop);
-  cells.resize(n_hex + mesh.bar2.size() / 2 + mesh.quad4.size() / 4, 0);
+  cells.resize(mesh.n_cells(), 0);
   return without_cells(mesh, cells);
 }
 
@@ -687,9 +678,9 @@ struct MeshColouring {
   }
 };
 
-// The hexahedra's boundary quads.
+// The hexahedra's boundary quads (the hexahedra are the first cells).
 vtkSmartPointer<vtkActor> solid_actor(const RenderMesh& mesh, const MeshColouring& c) {
-  const BoundaryQuads quads = boundary_quads(mesh.hex8);
+  const BoundaryQuads quads = boundary_quads(mesh.of(fem::ElementKind::Hex8));
   const auto n_faces = static_cast<vtkIdType>(quads.hex.size());
   vtkNew<vtkCellArray> polys;
   polys->AllocateExact(n_faces, 4 * n_faces);
@@ -713,40 +704,40 @@ vtkSmartPointer<vtkActor> solid_actor(const RenderMesh& mesh, const MeshColourin
 }
 
 // The shells' mid-surfaces.
-vtkSmartPointer<vtkActor> shell_actor(const RenderMesh& mesh, const MeshColouring& c,
-                                      std::size_t n_hex, std::size_t n_bar) {
-  const std::size_t n_quad = mesh.quad4.size() / 4;
+vtkSmartPointer<vtkActor> shell_actor(const RenderMesh& mesh, const MeshColouring& c) {
+  const auto& quad4 = mesh.of(fem::ElementKind::Quad4);
+  const std::size_t n_quad = mesh.n_of(fem::ElementKind::Quad4);
   vtkNew<vtkCellArray> polys;
   polys->AllocateExact(static_cast<vtkIdType>(n_quad), static_cast<vtkIdType>(4 * n_quad));
   for (std::size_t q = 0; q < n_quad; ++q) {
     vtkIdType ids[4];
     for (std::size_t k = 0; k < 4; ++k) {
-      ids[k] = static_cast<vtkIdType>(mesh.quad4[4 * q + k]);
+      ids[k] = static_cast<vtkIdType>(quad4[4 * q + k]);
     }
     polys->InsertNextCell(4, ids);
   }
   vtkNew<vtkPolyData> shells;
   shells->SetPoints(c.points);
   shells->SetPolys(polys);
-  c.colour(shells, n_hex + n_bar, n_quad);
+  c.colour(shells, mesh.first_cell(fem::ElementKind::Quad4), n_quad);
   return c.surface_actor_of(shells);
 }
 
 // The bars, as lines.
-vtkSmartPointer<vtkActor> bar_actor(const RenderMesh& mesh, const MeshColouring& c,
-                                    std::size_t n_hex) {
-  const std::size_t n_bar = mesh.bar2.size() / 2;
+vtkSmartPointer<vtkActor> bar_actor(const RenderMesh& mesh, const MeshColouring& c) {
+  const auto& bar2 = mesh.of(fem::ElementKind::Bar2);
+  const std::size_t n_bar = mesh.n_of(fem::ElementKind::Bar2);
   vtkNew<vtkCellArray> lines;
   lines->AllocateExact(static_cast<vtkIdType>(n_bar), static_cast<vtkIdType>(2 * n_bar));
   for (std::size_t b = 0; b < n_bar; ++b) {
-    const vtkIdType ids[2] = {static_cast<vtkIdType>(mesh.bar2[2 * b]),
-                              static_cast<vtkIdType>(mesh.bar2[2 * b + 1])};
+    const vtkIdType ids[2] = {static_cast<vtkIdType>(bar2[2 * b]),
+                              static_cast<vtkIdType>(bar2[2 * b + 1])};
     lines->InsertNextCell(2, ids);
   }
   vtkNew<vtkPolyData> bars;
   bars->SetPoints(c.points);
   bars->SetLines(lines);
-  c.colour(bars, n_hex, n_bar);
+  c.colour(bars, mesh.first_cell(fem::ElementKind::Bar2), n_bar);
   auto actor = c.actor_of(bars);
   // Lines in front of coincident hex faces and shells (bars on a surface stay visible).
   actor->GetMapper()->SetResolveCoincidentTopologyToPolygonOffset();
@@ -758,6 +749,17 @@ vtkSmartPointer<vtkActor> bar_actor(const RenderMesh& mesh, const MeshColouring&
   }
   return actor;
 }
+
+// Each kind's picture, in drawing order: the surfaces, then the lines drawn over them. A new
+// element kind adds its row.
+struct KindPicture {
+  fem::ElementKind kind;
+  vtkSmartPointer<vtkActor> (*actor)(const RenderMesh&, const MeshColouring&);
+};
+constexpr KindPicture kKindPictures[] = {{fem::ElementKind::Hex8, solid_actor},
+                                         {fem::ElementKind::Quad4, shell_actor},
+                                         {fem::ElementKind::Bar2, bar_actor}};
+static_assert(std::size(kKindPictures) == fem::kElementKinds.size(), "a picture per kind");
 
 // The annotation layer's title and scalar bar.
 void add_title_and_scalar_bar(vtkRenderer* annotation, const MeshColouring& c) {
@@ -849,9 +851,6 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
 
   // Geometry: the same points for the solid part, the bars and the shells.
   const std::size_t n_points = mesh.points.size() / 3;
-  const std::size_t n_hex = mesh.hex8.size() / 8;
-  const std::size_t n_bar = mesh.bar2.size() / 2;
-  const std::size_t n_quad = mesh.quad4.size() / 4;
   c.points = vtkSmartPointer<vtkPoints>::New();
   c.points->SetDataTypeToDouble();
   c.points->SetNumberOfPoints(static_cast<vtkIdType>(n_points));
@@ -869,9 +868,8 @@ void render_mesh_png(const RenderMesh& mesh, const MeshFigure& figure,
   scene->SetLayer(1);  // drawn over the annotation layer's background, no clear of its own
   scene->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
   scene->UseFXAAOff();
-  if (n_hex > 0) scene->AddActor(solid_actor(mesh, c));
-  if (n_quad > 0) scene->AddActor(shell_actor(mesh, c, n_hex, n_bar));
-  if (n_bar > 0) scene->AddActor(bar_actor(mesh, c, n_hex));
+  for (const KindPicture& p : kKindPictures)
+    if (mesh.n_of(p.kind) > 0) scene->AddActor(p.actor(mesh, c));
   apply_camera(scene, figure.camera, figure.focus_bounds);
 
   // Annotation layer: full window, owns the background, holds the title and the scalar bar.

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "fem/elements/element_kind.hpp"
+
 namespace ncfsim::render {
 
 // Where the pictures are drawn; both are Mesa's llvmpipe software renderer, no GPU, no display.
@@ -51,11 +53,32 @@ struct MeshField {
 };
 
 struct RenderMesh {
-  std::vector<double> points;       // xyz interleaved, [3*n_points]
-  std::vector<std::int64_t> hex8;   // 8 node ids per hexahedron (VTK ordering)
-  std::vector<std::int64_t> bar2;   // 2 node ids per bar
-  std::vector<std::int64_t> quad4;  // 4 node ids per shell, counter-clockwise (VTK_QUAD ordering)
-  std::vector<MeshField> fields;    // cell fields: values for hexes first, then bars, then shells
+  std::vector<double> points;  // xyz interleaved, [3*n_points]
+  // Node ids per element kind (fem/elements/element_kind.hpp, in kind order: hexahedra, bars,
+  // shells), nodes_per_element per cell in VTK ordering (a shell's counter-clockwise).
+  std::array<std::vector<std::int64_t>, fem::kElementKinds.size()> cells;
+  std::vector<MeshField> fields;  // cell fields: values for the kinds' cells in kind order
+
+  std::vector<std::int64_t>& of(fem::ElementKind k) { return cells[static_cast<std::size_t>(k)]; }
+  const std::vector<std::int64_t>& of(fem::ElementKind k) const {
+    return cells[static_cast<std::size_t>(k)];
+  }
+  std::size_t n_of(fem::ElementKind k) const {
+    return of(k).size() / static_cast<std::size_t>(fem::nodes_per_element(k));
+  }
+  std::size_t first_cell(fem::ElementKind k) const {
+    std::size_t n = 0;
+    for (fem::ElementKind j : fem::kElementKinds) {
+      if (j == k) break;
+      n += n_of(j);
+    }
+    return n;
+  }
+  std::size_t n_cells() const {
+    std::size_t n = 0;
+    for (fem::ElementKind k : fem::kElementKinds) n += n_of(k);
+    return n;
+  }
 };
 
 // Top: looking down -z, +y up. Front: looking along +y, +z up. Iso: from the (+x, -y, +z) octant,

@@ -18,35 +18,38 @@ fem::io::ResultMesh result_mesh(const fem::ExplicitSolver& s) {
   for (const auto& law : model.bar_laws) m.bar_law_names.push_back(law.name());
   const fem::ElementSet& hexes = mesh.elements(fem::ElementKind::Hex8);
   const bool tagged = hexes.ply.size() == hexes.size() && hexes.tow.size() == hexes.size();
+  auto& hex = m.hex();
   for (const auto& b : s.blocks<fem::Hex8Block>()) {
     const int material = b.material_index;
     for (std::size_t e = 0; e < b.n; ++e) {
-      for (int I = 0; I < 8; ++I) m.hex8.push_back(b.conn[static_cast<std::size_t>(I) * b.n + e]);
-      m.hex_part.push_back(b.part);
-      m.hex_user_id.push_back(b.user_id[e]);
-      m.hex_material.push_back(material);
+      for (int I = 0; I < 8; ++I) hex.conn.push_back(b.conn[static_cast<std::size_t>(I) * b.n + e]);
+      hex.part.push_back(b.part);
+      hex.user_id.push_back(b.user_id[e]);
+      hex.material.push_back(material);
       const auto k = static_cast<std::size_t>(b.mesh_hex[e]);
       m.hex_ply.push_back(tagged ? hexes.ply[k] : -1);
       m.hex_tow.push_back(tagged ? hexes.tow[k] : -1);
     }
   }
+  auto& bars = m.bars();
   for (const auto& b : s.blocks<fem::BarBlock>()) {
     const int law = model.parts[static_cast<std::size_t>(b.part)].bar_law;
     for (std::size_t e = 0; e < b.n; ++e) {
-      m.bar2.push_back(b.conn[e]);
-      m.bar2.push_back(b.conn[b.n + e]);
-      m.bar_part.push_back(b.part);
-      m.bar_user_id.push_back(b.user_id[e]);
-      m.bar_material.push_back(law);
+      bars.conn.push_back(b.conn[e]);
+      bars.conn.push_back(b.conn[b.n + e]);
+      bars.part.push_back(b.part);
+      bars.user_id.push_back(b.user_id[e]);
+      bars.material.push_back(law);
     }
   }
+  auto& shells = m.shells();
   for (const auto& b : s.blocks<fem::Shell4Block>()) {
     for (std::size_t e = 0; e < b.n; ++e) {
-      for (std::size_t I = 0; I < 4; ++I) m.quad4.push_back(b.conn[I * b.n + e]);
-      m.quad_part.push_back(b.part);
-      m.quad_user_id.push_back(b.user_id[e]);
+      for (std::size_t I = 0; I < 4; ++I) shells.conn.push_back(b.conn[I * b.n + e]);
+      shells.part.push_back(b.part);
+      shells.user_id.push_back(b.user_id[e]);
       // Elastic sections name a [[material]]; membrane-law sections are not in material_names.
-      m.quad_material.push_back(b.section.law ? -1 : b.material_index);
+      shells.material.push_back(b.section.law ? -1 : b.material_index);
       m.quad_thickness.push_back(b.section.thickness);
     }
   }
@@ -128,36 +131,25 @@ fem::Mesh mesh_from_stage_frame(const fem::io::StageFrame& frame, bool deformed)
   fem::Mesh m;
   m.coords = deformed ? frame.coordinates : rm.points;
   m.part_names = rm.part_names;
-  const std::size_t nh = rm.n_hex(), nb = rm.n_bar();
   m.node_user_id = rm.node_user_id;
-  if (nh) {
-    fem::ElementSet& hexes = m.elements(fem::ElementKind::Hex8);
-    for (std::size_t e = 0; e < nh; ++e) {
-      std::int32_t n[8];
-      for (std::size_t I = 0; I < 8; ++I) n[I] = static_cast<std::int32_t>(rm.hex8[8 * e + I]);
-      hexes.add(std::span<const std::int32_t>(n, 8), rm.hex_part[e]);
+  for (fem::ElementKind k : fem::kElementKinds) {
+    const fem::io::ResultCells& c = rm.of(k);
+    const std::size_t n = rm.n_of(k);
+    if (n == 0) continue;
+    fem::ElementSet& set = m.elements(k);
+    const auto nodes = static_cast<std::size_t>(fem::nodes_per_element(k));
+    std::int32_t ids[fem::kMaxNodesPerElement];
+    for (std::size_t e = 0; e < n; ++e) {
+      for (std::size_t I = 0; I < nodes; ++I)
+        ids[I] = static_cast<std::int32_t>(c.conn[nodes * e + I]);
+      set.add(std::span<const std::int32_t>(ids, nodes), c.part[e]);
     }
-    hexes.user_id = rm.hex_user_id;
+    if (c.user_id.size() == n) set.user_id = c.user_id;
+  }
+  if (rm.n_hex()) {
+    fem::ElementSet& hexes = m.elements(fem::ElementKind::Hex8);
     hexes.ply = rm.hex_ply;
     hexes.tow = rm.hex_tow;
-  }
-  if (nb) {
-    fem::ElementSet& bars = m.elements(fem::ElementKind::Bar2);
-    for (std::size_t e = 0; e < nb; ++e)
-      bars.add({static_cast<std::int32_t>(rm.bar2[2 * e]),
-                static_cast<std::int32_t>(rm.bar2[2 * e + 1])},
-               rm.bar_part[e]);
-    bars.user_id = rm.bar_user_id;
-  }
-  if (const std::size_t nq = rm.n_quad(); nq) {
-    fem::ElementSet& shells = m.elements(fem::ElementKind::Quad4);
-    for (std::size_t e = 0; e < nq; ++e)
-      shells.add({static_cast<std::int32_t>(rm.quad4[4 * e]),
-                  static_cast<std::int32_t>(rm.quad4[4 * e + 1]),
-                  static_cast<std::int32_t>(rm.quad4[4 * e + 2]),
-                  static_cast<std::int32_t>(rm.quad4[4 * e + 3])},
-                 rm.quad_part[e]);
-    if (rm.quad_user_id.size() == nq) shells.user_id = rm.quad_user_id;
   }
   m.fill_default_user_ids();  // whatever the file did not hold
   return m;

@@ -66,7 +66,8 @@ ExportResult export_impregnated(const std::filesystem::path& dir, const std::str
   std::map<std::int64_t, std::int32_t> element_of;
   for (std::size_t e = 0; e < n; ++e) {
     std::array<std::int32_t, 8> h{};
-    for (std::size_t k = 0; k < 8; ++k) h[k] = static_cast<std::int32_t>(mesh.hex8[8 * e + k]);
+    for (std::size_t k = 0; k < 8; ++k)
+      h[k] = static_cast<std::int32_t>(mesh.hex().conn[8 * e + k]);
     m.hex.push_back(h);
     std::array<double, 9> f{};
     for (int col = 0; col < 3; ++col)
@@ -74,9 +75,9 @@ ExportResult export_impregnated(const std::filesystem::path& dir, const std::str
         f[static_cast<std::size_t>(3 * row + col)] =
             axes[col]->values[3 * e + static_cast<std::size_t>(row)];
     m.frame.push_back(f);
-    m.material.push_back(mesh.hex_material.empty() ? 0 : mesh.hex_material[e]);
-    element_of[mesh.hex_user_id.empty() ? static_cast<std::int64_t>(e + 1) : mesh.hex_user_id[e]] =
-        static_cast<std::int32_t>(e);
+    m.material.push_back(mesh.hex().material.empty() ? 0 : mesh.hex().material[e]);
+    element_of[mesh.hex().user_id.empty() ? static_cast<std::int64_t>(e + 1)
+                                          : mesh.hex().user_id[e]] = static_cast<std::int32_t>(e);
   }
   // Kept stitches: bars with the yarn's constants as cell fields (after the hexahedra).
   if (const std::size_t nb = mesh.n_bar(); nb > 0) {
@@ -89,8 +90,8 @@ ExportResult export_impregnated(const std::filesystem::path& dir, const std::str
     auto& st = m.stitches;
     st.modulus = f[0]->values[n], st.area = f[1]->values[n], st.density = f[2]->values[n];
     for (std::size_t b = 0; b < nb; ++b)
-      st.bars.push_back({static_cast<std::int32_t>(mesh.bar2[2 * b]),
-                         static_cast<std::int32_t>(mesh.bar2[2 * b + 1])});
+      st.bars.push_back({static_cast<std::int32_t>(mesh.bars().conn[2 * b]),
+                         static_cast<std::int32_t>(mesh.bars().conn[2 * b + 1])});
   }
   const CsvTable mat = read_csv(dir / "materials.csv");
   const auto vf = mat.column("vf"), rho = mat.column("density_kg_m3");

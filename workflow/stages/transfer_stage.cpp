@@ -47,8 +47,8 @@ fem::MemoryEstimate transfer_memory(const fem::io::StageFrame& frame, bool figur
   constexpr double kFramePerNode = 32 + 24 + 48, kFramePerCell = 88 + 200;
   constexpr double kModelPerHex = 600, kWriterPerNode = 32, kWriterPerHex = 88;
   const double nodes = static_cast<double>(frame.n_points());
-  const double hex = static_cast<double>(frame.mesh.hex8.size() / 8);
-  const double cells = hex + static_cast<double>(frame.mesh.bar2.size() / 2);
+  const double hex = static_cast<double>(frame.mesh.hex().conn.size() / 8);
+  const double cells = hex + static_cast<double>(frame.mesh.bars().conn.size() / 2);
   fem::MemoryEstimate est;
   est.shares.push_back({"program", fem::kProgramBytes});
   est.shares.push_back({"source frame", kFramePerNode * nodes + kFramePerCell * cells});
@@ -93,20 +93,20 @@ void write_results(const std::filesystem::path& dir, const ImpregnatedModel& m,
   fem::io::ResultMesh rm;
   rm.points = m.points;
   for (const auto& h : m.hex)
-    for (auto n : h) rm.hex8.push_back(n);
-  rm.hex_part = m.hex_part;
+    for (auto n : h) rm.hex().conn.push_back(n);
+  rm.hex().part = m.hex_part;
   rm.part_names = m.part_names;
   rm.node_user_id = m.point_user_id;
-  rm.hex_user_id = m.hex_user_id;
-  rm.hex_material = m.vf_class;
+  rm.hex().user_id = m.hex_user_id;
+  rm.hex().material = m.vf_class;
   for (const auto& c : m.classes)
     rm.material_names.push_back(fmt::format("tow_vf_{:.3f}", c.fibre_volume_fraction));
   rm.hex_ply = m.hex_ply;
   rm.hex_tow = m.hex_tow;
-  for (const auto& b : m.stitch) rm.bar2.insert(rm.bar2.end(), {b[0], b[1]});
-  rm.bar_part = m.stitch_part;
-  rm.bar_user_id = m.stitch_user_id;
-  rm.bar_material.assign(m.stitch.size(), -1);
+  for (const auto& b : m.stitch) rm.bars().conn.insert(rm.bars().conn.end(), {b[0], b[1]});
+  rm.bars().part = m.stitch_part;
+  rm.bars().user_id = m.stitch_user_id;
+  rm.bars().material.assign(m.stitch.size(), -1);
   fem::io::Frame fr;
   fr.displacement.assign(m.points.size(), 0.0);
   // Cell fields hold the hexahedra, then the kept stitch bars (NaN where a kind lacks one).
