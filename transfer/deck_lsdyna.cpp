@@ -16,7 +16,6 @@ using deck::field;
 constexpr const char* kModeNames[6] = {"fibre tension",  "fibre compression",
                                        "matrix tension", "matrix compression",
                                        "in-plane shear", "transverse shear"};
-constexpr const auto& kFace = fem::kHex8Faces;
 
 std::string fields(std::initializer_list<double> v) {
   std::string s;
@@ -84,8 +83,8 @@ std::string segment_set(int id, const ExportModel& m,
   std::string s = fmt::format("*SET_SEGMENT\n{:>10}\n", id);
   for (auto [e, f] : faces) {
     const auto& h = m.hex[static_cast<std::size_t>(e)];
-    s += ints({h[kFace[f].corner[0]] + 1, h[kFace[f].corner[1]] + 1, h[kFace[f].corner[2]] + 1,
-               h[kFace[f].corner[3]] + 1});
+    s += ints({h[fem::kHex8Faces[f].corner[0]] + 1, h[fem::kHex8Faces[f].corner[1]] + 1,
+               h[fem::kHex8Faces[f].corner[2]] + 1, h[fem::kHex8Faces[f].corner[3]] + 1});
   }
   return s;
 }

@@ -18,8 +18,6 @@ namespace ncfsim::transfer {
 
 namespace {
 
-constexpr const auto& kFace = fem::kHex8Faces;
-
 std::string I(long long v) { return fmt::format("{:>10}", v); }
 std::string F(double v) { return fmt::format("{:>20.10g}", v); }
 
@@ -373,7 +371,7 @@ double estimated_first_step(const ExportModel& m) {
       return m.nodes[static_cast<std::size_t>(h[static_cast<std::size_t>(k)])];
     };
     double largest = 0;
-    for (const auto& face : kFace) {
+    for (const auto& face : fem::kHex8Faces) {
       const auto a = p(face.corner[0]), b = p(face.corner[1]), c = p(face.corner[2]),
                  d = p(face.corner[3]);
       const double u[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};

@@ -21,7 +21,6 @@ namespace {
 // engine's.
 constexpr double kXi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
                               {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
-constexpr const auto& kFace = fem::kHex8Faces;
 
 // d(position)/d(natural coordinate) at the element centre, columns xi, eta, zeta.
 Eigen::Matrix3d centre_jacobian(const std::array<V3, 8>& x) {
@@ -86,9 +85,12 @@ double thinnest_tow(const ImpregnatedModel& m, const std::vector<V3>& x) {
   for (const auto& h : m.hex) {
     V3 bottom, top;
     for (std::size_t k = 0; k < 4; ++k)
-      bottom += 0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[0].corner[k])])],
+      bottom +=
+          0.25 *
+          x[static_cast<std::size_t>(h[static_cast<std::size_t>(fem::kHex8Faces[0].corner[k])])],
           top +=
-          0.25 * x[static_cast<std::size_t>(h[static_cast<std::size_t>(kFace[1].corner[k])])];
+          0.25 *
+          x[static_cast<std::size_t>(h[static_cast<std::size_t>(fem::kHex8Faces[1].corner[k])])];
     thinnest = std::min(thinnest, norm(top - bottom));
   }
   return thinnest;
@@ -104,7 +106,7 @@ std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>
     for (int f = 0; f < 6; ++f) {
       std::array<std::int32_t, 4> key{};
       for (std::size_t k = 0; k < 4; ++k)
-        key[k] = m.hex[e][static_cast<std::size_t>(kFace[f].corner[k])];
+        key[k] = m.hex[e][static_cast<std::size_t>(fem::kHex8Faces[f].corner[k])];
       std::sort(key.begin(), key.end());
       ++count[key];
       face_of[key] = {static_cast<std::int32_t>(e), f};
@@ -115,8 +117,8 @@ std::vector<TiePairs> tie_pairs(const ImpregnatedModel& m, const std::vector<V3>
     const auto [e, f] = face_of[key];
     std::array<V3, 4> c;
     for (std::size_t k = 0; k < 4; ++k)
-      c[k] = x[static_cast<std::size_t>(
-          m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(kFace[f].corner[k])])];
+      c[k] = x[static_cast<std::size_t>(m.hex[static_cast<std::size_t>(e)][static_cast<std::size_t>(
+          fem::kHex8Faces[f].corner[k])])];
     const V3 centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
     const V3 normal = normalized(cross(c[2] - c[0], c[3] - c[1]));  // outward for VTK face order
     double radius = 0;

@@ -26,7 +26,7 @@ namespace ncfsim::fem::io {
 
 namespace {
 
-constexpr int kFrameDigits = 5;
+constexpr int kVtuFrameDigits = 5;
 constexpr const char* kPvdName = "results.pvd";
 constexpr const char* kFramesDir = "frames";
 
@@ -62,7 +62,7 @@ struct VtuSeriesWriter::Impl {
   void build_topology();
   std::string pvd_text() const;
   std::string frame_name(std::size_t index) const {
-    return std::string("frame_") + detail::zero_padded(index, kFrameDigits) + ".vtu";
+    return std::string("frame_") + detail::zero_padded(index, kVtuFrameDigits) + ".vtu";
   }
 };
 

@@ -20,7 +20,7 @@ namespace {
 // 2: the stage hand-off datasets (user ids, materials, ply/tow). Shells (quad4) did not change it:
 // their datasets are only added, only to a file that has shells (docs/output.md).
 constexpr int kFormatVersion = 2;
-constexpr int kFrameDigits = 6;
+constexpr int kH5FrameDigits = 6;
 constexpr const char* kH5Name = "results.h5";
 constexpr const char* kXdmfName = "results.xdmf";
 
@@ -490,7 +490,7 @@ void XdmfResultWriter::write_frame(const Frame& frame) {
   validate_frame(impl_->mesh, frame);
   Impl::FrameRecord record{frame.time,
                            frame.cycle,
-                           "/frames/" + detail::zero_padded(impl_->frames.size(), kFrameDigits),
+                           "/frames/" + detail::zero_padded(impl_->frames.size(), kH5FrameDigits),
                            {}};
   for (const FrameField& f : frame.fields) {
     record.fields.push_back({f.name, f.on_cells, f.n_components});
@@ -534,7 +534,7 @@ XdmfResultWriter XdmfResultWriter::reopen(std::filesystem::path out_dir, ResultM
   impl->mesh = std::move(mesh);
   for (std::size_t k = 0; k < frames.size(); ++k) {
     Impl::FrameRecord record{
-        frames[k].time, frames[k].cycle, "/frames/" + detail::zero_padded(k, kFrameDigits), {}};
+        frames[k].time, frames[k].cycle, "/frames/" + detail::zero_padded(k, kH5FrameDigits), {}};
     for (const auto& f : frames[k].fields)
       record.fields.push_back({f.name, f.on_cells, f.n_components});
     impl->frames.push_back(std::move(record));
@@ -561,7 +561,7 @@ XdmfResultWriter XdmfResultWriter::reopen(std::filesystem::path out_dir, ResultM
     }
     // The kept frames must be there; the groups of later ones go.
     for (std::size_t k = 0;; ++k) {
-      const std::string group = "/frames/" + detail::zero_padded(k, kFrameDigits);
+      const std::string group = "/frames/" + detail::zero_padded(k, kH5FrameDigits);
       const htri_t exists = H5Lexists(file.get(), group.c_str(), H5P_DEFAULT);
       h5_check(exists < 0 ? -1 : 0, impl->at(group), "H5Lexists");
       if (k < frames.size()) {
