@@ -258,7 +258,8 @@ struct RadiossDeck {
       throw std::invalid_argument("export: the Radioss deck's ties need the crush's first step");
     struct Spring {
       std::size_t tie, point;
-      long long p;  // the /RBE3 node
+      long long p;                // the /RBE3 node
+      std::array<double, 4> w{};  // its corners' weights
     };
     std::vector<Spring> springs;
     double k_min = 1e300, cap_min = 1e300;
@@ -278,7 +279,7 @@ struct RadiossDeck {
         for (std::size_t a = 0; a < 4; ++a)
           for (std::size_t k = 0; k < 3; ++k)
             x[k] += w[a] * m.nodes[static_cast<std::size_t>(q.corner[a])][k];
-        springs.push_back({i, j, static_cast<long long>(++next_node)});
+        springs.push_back({i, j, static_cast<long long>(++next_node), w});
         s += I(springs.back().p) + F(x[0]) + F(x[1]) + F(x[2]) + "\n";
         k_min = std::min(k_min, q.stiffness), cap_min = std::min(cap_min, cap(i, q));
       }
@@ -291,11 +292,10 @@ struct RadiossDeck {
     long long rbe3 = 0;
     for (const auto& sp : springs) {
       const auto& q = m.ties[sp.tie].points[sp.point];
-      const auto w = weights(q);
       s += fmt::format("/RBE3/{}\n{}_{}\n", ++rbe3, m.ties[sp.tie].name, q.node + 1) + I(sp.p) +
            "   111 000" + I(4) + I(0) + "\n";
       for (std::size_t a = 0; a < 4; ++a)
-        s += F(w[a]) + "   111 000" + I(0) + I(kCornerGroup + q.corner[a] + 1) + "\n";
+        s += F(sp.w[a]) + "   111 000" + I(0) + I(kCornerGroup + q.corner[a] + 1) + "\n";
     }
     // Classes: log bins of stiffness and failure force, each at its bin's geometric centre.
     const auto bin = [](double v, double lo) {
