@@ -27,24 +27,19 @@ namespace {
 constexpr double kPerNode = 323;            // 9 PETSc nodal vectors, solver masks, mesh coordinates
 constexpr double kPerNodeErosion = 5;       // node-to-element map, freed flags
 constexpr double kPerNodeDynamicMass = 24;  // the mass-scaling scratch
-constexpr double kPerNodeShellGroup = 59;   // each shell group's rotational arrays (all nodes)
 constexpr double kPerNodeParallel = 64;     // ownership, halo positions, star-forest buffers
-constexpr double kHexFixed = 48 + 52 + 16;  // integers of the block and the mesh, anisotropy
-constexpr double kHexDoubles = 75;          // stress, strain, hourglass, frames, volumes, ...
-constexpr double kHexOwnAxes = 76;          // per-element axes and material (a formed part)
-constexpr double kPerBar = 88;
-constexpr double kShellFixed = 32 + 36, kShellDoubles = 41;
-constexpr double kToolPerNode = 56;       // contact node, friction state, proximity reference
-constexpr double kToolPerTriangle = 120;  // STL tools: triangles, normals, buckets
-constexpr double kSetupPerElement = 24;   // renumbering keys, sort buffers (set-up, kept by malloc)
+constexpr double kToolPerNode = 56;         // contact node, friction state, proximity reference
+constexpr double kToolPerTriangle = 120;    // STL tools: triangles, normals, buckets
+constexpr double kSetupPerElement = 24;  // renumbering keys, sort buffers (set-up, kept by malloc)
+// Per element, by kind: element_memory (fem/elements/element_kind.hpp).
 
 // Output on the root: each result writer's copy of the mesh, then the largest of one frame in the
 // making (all cell arrays are sized to every cell), the checkpoint's copy of the state, and the
 // figures drawn at the end (measured, above).
-constexpr double kWriterPerNode = 32, kWriterPerHex = 88, kWriterPerBar = 32, kWriterPerQuad = 56;
-constexpr double kFramePerCell = 200, kFramePerNode = 72, kVtuPerNode = 72, kVtuPerHex = 77;
-constexpr double kCheckpointPerNode = 72, kCheckpointPerHex = 8 * 38;
-constexpr double kFiguresPerNode = 490, kFiguresPerHex = 1770;
+constexpr double kWriterPerNode = 32;
+constexpr double kFramePerCell = 200, kFramePerNode = 72, kVtuPerNode = 72;
+constexpr double kCheckpointPerNode = 72;
+constexpr double kFiguresPerNode = 490;
 
 double n_of(const Mesh& m, ElementKind k) { return static_cast<double>(m.elements(k).size()); }
 
@@ -75,42 +70,52 @@ MemoryEstimate estimate_memory(const Model& model, int ranks, const OutputMemory
   MemoryEstimate est;
   est.ranks = std::max(1, ranks);
   const double nodes = static_cast<double>(mesh.n_nodes());
-  const double n_hex = n_of(mesh, ElementKind::Hex8), n_bar = n_of(mesh, ElementKind::Bar2),
-               n_quad = n_of(mesh, ElementKind::Quad4);
+  std::array<double, kElementKinds.size()> n{};  // elements of each kind
+  double cells = 0;
+  for (ElementKind k : kElementKinds) cells += n[static_cast<std::size_t>(k)] = n_of(mesh, k);
+  // Sum of a per-element figure of the kinds' rows, over the model's elements.
+  const auto per_element = [&](double ElementMemory::*field) {
+    double s = 0;
+    for (ElementKind k : kElementKinds)
+      s += element_memory(k).*field * n[static_cast<std::size_t>(k)];
+    return s;
+  };
   bool material_failure = false;
   for (const auto& m : model.materials) material_failure |= m->failure_history_row() >= 0;
   const bool erosion =
       model.time.erosion_step_ratio > 0 || model.time.mass_scaling_erode_at_cap || material_failure;
 
   est.shares.push_back({"program", kProgramBytes});
-  // Nodes: each shell part is a group of its own with arrays over every node of the model.
-  std::vector<char> shell_part(mesh.part_names.size(), 0);
-  for (auto p : mesh.elements(ElementKind::Quad4).part) shell_part[static_cast<std::size_t>(p)] = 1;
-  const double shell_groups =
-      static_cast<double>(std::count(shell_part.begin(), shell_part.end(), 1));
+  // Nodes: a kind whose every part is a group of its own keeps arrays over every node per part.
   double per_node = kPerNode + (erosion ? kPerNodeErosion : 0) +
                     (model.time.mass_scaling_dynamic ? kPerNodeDynamicMass : 0) +
-                    kPerNodeShellGroup * shell_groups + (est.ranks > 1 ? kPerNodeParallel : 0);
+                    (est.ranks > 1 ? kPerNodeParallel : 0);
+  for (ElementKind k : kElementKinds) {
+    if (element_memory(k).node_arrays_per_part == 0) continue;
+    std::vector<char> has(mesh.part_names.size(), 0);
+    for (auto p : mesh.elements(k).part) has[static_cast<std::size_t>(p)] = 1;
+    per_node += element_memory(k).node_arrays_per_part *
+                static_cast<double>(std::count(has.begin(), has.end(), 1));
+  }
   est.shares.push_back({"nodes", per_node * nodes});
 
-  // Hexahedra: the block's doubles grow with the material law's history.
-  if (n_hex > 0) {
-    const ElementSet& hex = mesh.elements(ElementKind::Hex8);
-    double bytes = 0;
-    for (std::size_t e = 0; e < hex.size(); ++e) {
-      int mat = hex.material.empty() ? -1 : hex.material[e];
-      if (mat < 0) mat = model.parts[static_cast<std::size_t>(hex.part[e])].material;
-      const int nh = mat >= 0 && static_cast<std::size_t>(mat) < model.materials.size()
-                         ? model.materials[static_cast<std::size_t>(mat)]->n_history()
-                         : 0;
-      bytes += kHexFixed + 8 * (kHexDoubles + nh);
-    }
-    if (!hex.material_axes.empty()) bytes += kHexOwnAxes * n_hex;
-    est.shares.push_back({"hexahedra", bytes});
+  // Elements, kind by kind: a group's doubles grow with its material law's history.
+  for (ElementKind k : kElementKinds) {
+    const ElementSet& set = mesh.elements(k);
+    if (set.size() == 0) continue;
+    const ElementMemory em = element_memory(k);
+    double bytes = (em.fixed + 8 * em.doubles) * static_cast<double>(set.size());
+    if (em.law_history)
+      for (std::size_t e = 0; e < set.size(); ++e) {
+        int mat = set.material.empty() ? -1 : set.material[e];
+        if (mat < 0) mat = model.parts[static_cast<std::size_t>(set.part[e])].material;
+        if (mat >= 0 && static_cast<std::size_t>(mat) < model.materials.size())
+          bytes += 8.0 * model.materials[static_cast<std::size_t>(mat)]->n_history();
+      }
+    if (!set.material_axes.empty()) bytes += em.own_axes * static_cast<double>(set.size());
+    est.shares.push_back({em.share, bytes});
   }
-  if (n_bar > 0) est.shares.push_back({"bars", kPerBar * n_bar});
-  if (n_quad > 0) est.shares.push_back({"shells", (kShellFixed + 8 * kShellDoubles) * n_quad});
-  est.shares.push_back({"set-up", kSetupPerElement * (n_hex + n_bar + n_quad)});
+  est.shares.push_back({"set-up", kSetupPerElement * cells});
 
   for (const auto& c : model.contacts)
     est.shares.push_back({"contact '" + c->name() + "'", c->estimated_bytes(mesh, erosion)});
@@ -123,21 +128,20 @@ MemoryEstimate estimate_memory(const Model& model, int ranks, const OutputMemory
   if (tools > 0) est.shares.push_back({"tools", tools});
 
   // The root's output: writers' meshes, then the largest of a frame, a checkpoint, the figures.
-  const double cells = n_hex + n_bar + n_quad;
   double out = 0, transient = 0;
   if (output.frames) {
     const double writers = output.vtu ? 2.0 : 1.0;
-    out += writers * (kWriterPerNode * nodes + kWriterPerHex * n_hex + kWriterPerBar * n_bar +
-                      kWriterPerQuad * n_quad);
-    if (output.vtu) out += kVtuPerHex * n_hex;
+    out += writers * (kWriterPerNode * nodes + per_element(&ElementMemory::writer));
+    if (output.vtu) out += per_element(&ElementMemory::vtu);
     transient =
         kFramePerCell * cells + kFramePerNode * nodes + (output.vtu ? kVtuPerNode * nodes : 0.0);
   }
   if (output.checkpoints)
-    transient = std::max(transient, kCheckpointPerNode * nodes + kCheckpointPerHex * n_hex);
-  if (output.figures)
     transient =
-        std::max(transient, kFiguresBytes + kFiguresPerNode * nodes + kFiguresPerHex * n_hex);
+        std::max(transient, kCheckpointPerNode * nodes + per_element(&ElementMemory::checkpoint));
+  if (output.figures)
+    transient = std::max(
+        transient, kFiguresBytes + kFiguresPerNode * nodes + per_element(&ElementMemory::figures));
   if (out + transient > 0) est.shares.push_back({"output", out + transient});
   est.root_only = out + transient;
   return est;

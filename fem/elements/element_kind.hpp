@@ -60,6 +60,28 @@ constexpr ElementOutput element_output(ElementKind k) {
   return o[static_cast<int>(k)];
 }
 
+/// What one element of a kind costs in memory, bytes (fem/memory_estimate.cpp; counted from the
+/// arrays, but `figures`, measured: docs/performance.md, "Memory"). Every kind's row is summed
+/// alike, so a new kind's memory is this row.
+struct ElementMemory {
+  const char* share;            // the estimate's line ("hexahedra")
+  double fixed;                 // integers (and any fixed doubles) of the group and the mesh
+  double doubles;               // doubles of the group's state, before the material law's history
+  bool law_history;             // + the law's history doubles, kept per element by the group
+  double own_axes;              // per-element material axes and material (a formed part's mesh)
+  double node_arrays_per_part;  // per node of the model, for each part of the kind (own group)
+  double writer;                // each result writer's copy of the cells
+  double vtu;                   // the VTU writer's own topology
+  double checkpoint;            // a checkpoint's copy of the element's state
+  double figures;               // what the figures drawn at the end add
+};
+constexpr ElementMemory element_memory(ElementKind k) {
+  constexpr ElementMemory m[] = {{"hexahedra", 48 + 52 + 16, 75, true, 76, 0, 88, 77, 8 * 38, 1770},
+                                 {"bars", 88, 0, false, 0, 0, 32, 0, 0, 0},
+                                 {"shells", 32 + 36, 41, false, 0, 59, 56, 0, 0, 0}};
+  return m[static_cast<int>(k)];
+}
+
 /// A two-node element must join two different nodes (checked by Mesh::validate).
 constexpr bool element_needs_distinct_nodes(ElementKind k) { return nodes_per_element(k) == 2; }
 
