@@ -332,6 +332,11 @@ void PenaltyContact::sort_segments(const double* x) {
   const std::size_t ng = n_groups_, n_node = surf_.n_nodes(), n_act = active_seg_.size();
   const double margin = margin_;
   const double lim = 1.0 + 2.0 * cfg_.edge_tolerance;  // the narrow phase's extended edge
+  // Until the next sort each node moves less than reach = (margin - thickness) / 2, and a point
+  // of a segment's face extended to lim, a combination of its corners with weights summing to
+  // at most lim^2 in absolute value, less than lim^2 reach: a node farther than `far` (10 % over
+  // that) from a flat face cannot come within the thickness of it before the next sort.
+  const double far = cfg_.thickness + 0.55 * (1.0 + lim * lim) * (margin - cfg_.thickness);
   resort_ = false;
   checked_d_ = 0, travel_checked_ = travel_;
   // Frames of all segments, grown boxes of the active ones.
@@ -443,19 +448,20 @@ void PenaltyContact::sort_segments(const double* x) {
       const double g = (p[0] - f.c[0]) * sn[0] + (p[1] - f.c[1]) * sn[1] + (p[2] - f.c[2]) * sn[2];
       if (g < -(f.depth + margin))
         continue;  // behind the segment: out of reach until the next sort
-      // In front of the segment or beside it by more than the margin, measured in its own frame:
+      // In front of a flat segment, or beside it, by more than `far`, measured in its own frame:
       // out of reach until the next sort, as the box test says of a face along the axes (a face
       // at 45 deg to them, as a +-45 ply's are, has a box reaching far beside it: a third of the
       // candidates it let through were over 0.1 mm beside their segment). Beside: past the
       // narrow phase's extended edge (lim), the distance to the line |xi| = lim being
-      // (|xi| - lim) / |e1|. A degenerate frame (e1 or e2 zero) is not judged.
-      {
+      // (|xi| - lim) / |e1|. Warped or skewed faces (a twisted tow in a sheared picture frame),
+      // whose projection is not the distance, and degenerate frames are left to the box.
+      if (far > 0 && std::abs(f.hn) <= margin && std::abs(f.he1) <= 0.5 && std::abs(f.he2) <= 0.5) {
         const SegmentProjection pr = project_on_segment(f, p[0], p[1], p[2]);
-        if (pr.gap > margin) continue;
+        if (pr.gap > far) continue;
         const double l1 = f.e1[0] * f.e1[0] + f.e1[1] * f.e1[1] + f.e1[2] * f.e1[2];
         const double l2 = f.e2[0] * f.e2[0] + f.e2[1] * f.e2[1] + f.e2[2] * f.e2[2];
-        if (std::abs(pr.xi) - lim > margin * std::sqrt(l1) && l1 > 0) continue;
-        if (std::abs(pr.eta) - lim > margin * std::sqrt(l2) && l2 > 0) continue;
+        if (std::abs(pr.xi) - lim > far * std::sqrt(l1) && l1 > 0) continue;
+        if (std::abs(pr.eta) - lim > far * std::sqrt(l2) && l2 > 0) continue;
       }
       const std::int32_t* en = &surf_.seg_elem_nodes[8 * s];
       bool own = false;
