@@ -1,11 +1,11 @@
-// The broad phase's contract: a node is a candidate of a segment when it lies within the search
-// margin of it, measured in the segment's own frame (in front of it, beside its extended edge, or
-// behind it within its depth plus the margin), so the candidates do not depend on how a part
-// lies relative to the coordinate axes. The bucket grid's boxes are axis-aligned: the box of a
-// wide tow's face at 45 deg to the axes covers about twice the face, and on a +-45 fabric the
-// other ply's nodes over the neighbouring faces fall inside it (on the CI hemisphere 2.75
-// candidates per node, 0.98 of them within the margin in the segments' frames; the forming
-// results were the same byte for byte without the others).
+// The broad phase's contract: a node is a candidate of a flat segment when it lies within reach
+// of it measured in the segment's own frame (in front of it or beside its extended edge by at
+// most `far`, a little over the margin; behind it within its depth plus the margin), so the
+// candidates do not depend on how a part lies relative to the coordinate axes. The bucket grid's
+// boxes are axis-aligned: the box of a wide tow's face at 45 deg to the axes covers about twice
+// the face, and on a +-45 fabric the other ply's nodes over the neighbouring faces fall inside it
+// (on the CI hemisphere 2.75 candidates per node, 1.28 with the frame's test; the forming results
+// the same byte for byte, fem/contact/README.md).
 //  * Two crossed plies (tows at +45 and -45 deg, 2 mm wide, one hexahedron across, 0.05 mm apart:
 //    within the margin) have the same candidates whether their tows lie at +-45 deg to the axes
 //    or along them, and when the upper ply is driven onto the lower the same number of nodes
