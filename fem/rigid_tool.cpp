@@ -203,9 +203,45 @@ V3 tool_axis(const RigidTool& t) {
   return t.surface.axis;
 }
 
+double tool_velocity_scale(const ToolMotion& m, double t) {
+  const auto& ct = m.curve_time;
+  if (ct.empty()) return 1.0;
+  if (t <= ct.front()) return m.curve_scale.front();
+  if (t >= ct.back()) return m.curve_scale.back();
+  const auto k = static_cast<std::size_t>(std::upper_bound(ct.begin(), ct.end(), t) - ct.begin());
+  const double w = (t - ct[k - 1]) / (ct[k] - ct[k - 1]);
+  return (1 - w) * m.curve_scale[k - 1] + w * m.curve_scale[k];
+}
+
 V3 tool_prescribed_velocity(const RigidTool& tool, double t) {
   if (tool.motion.kind != ToolMotion::Kind::Velocity) return {};
-  return smooth_ramp(t, tool.motion.ramp_time) * tool.motion.velocity;
+  return (smooth_ramp(t, tool.motion.ramp_time) * tool_velocity_scale(tool.motion, t)) *
+         tool.motion.velocity;
+}
+
+double tool_prescribed_travel(const RigidTool& tool, double t) {
+  if (tool.motion.kind != ToolMotion::Kind::Velocity || !(t > 0)) return 0.0;
+  // Simpson's rule between the breaks of the ramp and the curve: the speed is a cubic there
+  // (ramp) times a linear (curve), a quartic, which 8 Simpson intervals integrate to ~1e-6.
+  std::vector<double> breaks{0.0, t};
+  if (tool.motion.ramp_time > 0 && tool.motion.ramp_time < t)
+    breaks.push_back(tool.motion.ramp_time);
+  for (const double c : tool.motion.curve_time)
+    if (c > 0 && c < t) breaks.push_back(c);
+  std::sort(breaks.begin(), breaks.end());
+  const double speed = norm(tool.motion.velocity);
+  const auto v = [&](double s) {
+    return smooth_ramp(s, tool.motion.ramp_time) * tool_velocity_scale(tool.motion, s);
+  };
+  double travel = 0;
+  for (std::size_t b = 0; b + 1 < breaks.size(); ++b) {
+    const double a = breaks[b], h = (breaks[b + 1] - a) / 8;
+    if (!(h > 0)) continue;
+    double sum = v(a) + v(a + 8 * h);
+    for (int i = 1; i < 8; ++i) sum += (i % 2 ? 4.0 : 2.0) * v(a + i * h);
+    travel += sum * h / 3;
+  }
+  return speed * travel;
 }
 
 namespace {

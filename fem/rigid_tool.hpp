@@ -76,6 +76,10 @@ struct ToolMotion {
   enum class Kind { Fixed, Velocity, Force } kind = Kind::Fixed;
   V3 velocity;              // Velocity: target velocity after the ramp
   double ramp_time = 0;     // smooth (C1) ramp from rest
+  // Velocity: a scale of `velocity` over time, piecewise linear through (curve_time[k],
+  // curve_scale[k]) and held past either end (empty: 1); it multiplies the ramp. A forming
+  // process's speed profile: slow while the fabric stores little, full speed after.
+  std::vector<double> curve_time, curve_scale;
   V3 axis{0, 0, 1};         // Force: direction of the applied force and of the free motion
   double force = 0;         // Force: magnitude (N), applied along `axis`
   double mass = 0;          // Force: tool mass (kg)
@@ -119,8 +123,14 @@ inline double smooth_ramp(double t, double t_ramp) {
   return s * s * (3 - 2 * s);
 }
 
+/// The velocity curve's scale at time t: piecewise linear, held past either end; 1 without one.
+double tool_velocity_scale(const ToolMotion& m, double t);
+
 /// Prescribed tool velocity at time t (Velocity kind).
 V3 tool_prescribed_velocity(const RigidTool& tool, double t);
+
+/// Distance a Velocity tool travels from 0 to t (its speed's integral: ramp and curve).
+double tool_prescribed_travel(const RigidTool& tool, double t);
 
 /// Axis a tool reports its scalar force and displacement along (a punch's stroke): its motion
 /// direction, the force's axis of a force-driven tool, else its surface's axis.

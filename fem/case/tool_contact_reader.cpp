@@ -50,12 +50,32 @@ void read_rigid_surface(const TableReader& t, RigidSurface& s) {
 
 namespace {
 
+// The speed profile of a Velocity tool: times strictly increasing from 0, scales >= 0.
+void read_velocity_curve(const TableReader& t, ToolMotion& m) {
+  if (!t.has("velocity_curve_time") && !t.has("velocity_curve_scale")) return;
+  if (!t.has("velocity_curve_time"))
+    t.fail("velocity_curve_scale", "needs velocity_curve_time beside it (the times, s)");
+  if (!t.has("velocity_curve_scale"))
+    t.fail("velocity_curve_time", "needs velocity_curve_scale beside it (the scales of velocity)");
+  m.curve_time = t.numbers("velocity_curve_time", Range::non_negative(), 2);
+  m.curve_scale = t.numbers("velocity_curve_scale", Range::closed(0, 1e3), 2);
+  if (m.curve_scale.size() != m.curve_time.size())
+    t.fail("velocity_curve_scale", "has " + std::to_string(m.curve_scale.size()) + " values for " +
+                                       std::to_string(m.curve_time.size()) +
+                                       " times in velocity_curve_time");
+  for (std::size_t k = 1; k < m.curve_time.size(); ++k)
+    if (!(m.curve_time[k] > m.curve_time[k - 1]))
+      t.fail("velocity_curve_time", "must increase strictly (value " + std::to_string(k + 1) +
+                                        " is not after value " + std::to_string(k) + ")");
+}
+
 void read_tool_motion(const TableReader& t, ToolMotion& m) {
   const std::string motion = t.choice("motion", {"fixed", "velocity", "force"}, "fixed");
   if (motion == "velocity") {
     m.kind = ToolMotion::Kind::Velocity;
     m.velocity = V3::from(t.vec3("velocity"));
     m.ramp_time = t.number("ramp_time", 0.0, Range::non_negative());
+    read_velocity_curve(t, m);
   } else if (motion == "force") {
     m.kind = ToolMotion::Kind::Force;
     m.axis = read_unit_vector(t, "force_axis", {0, 0, -1});

@@ -519,8 +519,8 @@ void check_crush_process(const CaseReadContext& ctx, const TableReader& crush,
                     "at most {:.4g} s",
                     time.history_interval, 1.0 / time.history_interval, cs.cfc, cs.cfc, needed),
         fmt::format("{:g}", time.history_interval), fmt::format("<= {:.4g}", needed));
-  // The punch must reach the part: its travel by the end time (half the C1 ramp at full speed)
-  // against the gap to the nearest of its contact nodes at the start.
+  // The punch must reach the part: its travel by the end time (ramp and speed curve) against the
+  // gap to the nearest of its contact nodes at the start.
   const auto& mesh = ctx.model.mesh;
   double gap_min = std::numeric_limits<double>::infinity();
   const auto gap_of = [&](std::size_t i) {
@@ -533,8 +533,7 @@ void check_crush_process(const CaseReadContext& ctx, const TableReader& crush,
     for (const auto i : tool.contact_nodes) gap_of(static_cast<std::size_t>(i));
   else
     for (std::size_t i = 0; i < mesh.n_nodes(); ++i) gap_of(i);
-  const double travel =
-      speed * std::max(0.0, time.end_time - 0.5 * std::min(tool.motion.ramp_time, time.end_time));
+  const double travel = fem::tool_prescribed_travel(tool, time.end_time);
   if (std::isfinite(gap_min) && gap_min - tool.thickness > travel)
     throw InputError(
         ctx.file, "time.end_time",

@@ -382,6 +382,37 @@ TEST(CaseReading, SeatedPlaneSitsItsClearanceFromTheNearestNode) {
   }
 }
 
+// A tool's speed curve: both arrays or neither, as many of each, times strictly increasing;
+// each fault names its key.
+TEST(CaseReading, ToolVelocityCurveNamesItsKeyWhenIllFormed) {
+  const auto key_of = [](const std::string& curve) -> std::string {
+    const fs::path f = write_case(
+        "curve", contact_case("friction = 0.1\n") +
+                     "[[tool]]\nname = \"punch\"\nshape = \"plane\"\npoint = [0.0, 0.0, -0.01]\n"
+                     "motion = \"velocity\"\nvelocity = [0.0, 0.0, 1.0]\n" +
+                     curve);
+    try {
+      const auto ec = workflow::load_engine_case(f, {});
+      return ec.model.tools.at(0).motion.curve_time.size() == 3 ? "(read)" : "(not read)";
+    } catch (const InputError& e) {
+      return e.key();
+    }
+  };
+  EXPECT_EQ(key_of("velocity_curve_time = [0.0, 0.01, 0.02]\n"
+                   "velocity_curve_scale = [0.3, 0.3, 1.0]\n"),
+            "(read)");
+  EXPECT_EQ(key_of("velocity_curve_time = [0.0, 0.01]\n"), "tool[0].velocity_curve_time");
+  EXPECT_EQ(key_of("velocity_curve_scale = [0.3, 1.0]\n"), "tool[0].velocity_curve_scale");
+  EXPECT_EQ(key_of("velocity_curve_time = [0.0, 0.01, 0.02]\nvelocity_curve_scale = [0.3, 1.0]\n"),
+            "tool[0].velocity_curve_scale");
+  EXPECT_EQ(key_of("velocity_curve_time = [0.0, 0.02, 0.01]\n"
+                   "velocity_curve_scale = [0.3, 0.3, 1.0]\n"),
+            "tool[0].velocity_curve_time");
+  EXPECT_EQ(key_of("velocity_curve_time = [0.0, 0.01, 0.02]\n"
+                   "velocity_curve_scale = [0.3, -0.3, 1.0]\n"),
+            "tool[0].velocity_curve_scale");
+}
+
 // [[output.target]]: exactly one of target and target_quantity, at most one tolerance; a bad one
 // names its key.
 TEST(CaseReading, OutputTargetNamesItsKeyWhenIllFormed) {

@@ -253,6 +253,10 @@ transfer::ExportModel crush_export_model(const EngineCase& ec) {
     x.point = {srf.point.x, srf.point.y, srf.point.z};
     x.axis = {srf.axis.x, srf.axis.y, srf.axis.z};
     x.radius = srf.radius;
+    if (!tool.motion.curve_time.empty())
+      throw InputError(file, "tool[" + std::to_string(t) + "].velocity_curve_time",
+                       "a tool with a speed curve is not exported (the decks carry a smooth "
+                       "ramp to a constant velocity)");
     if (tool.motion.kind == fem::ToolMotion::Kind::Velocity) {
       x.velocity = {tool.motion.velocity.x, tool.motion.velocity.y, tool.motion.velocity.z};
       x.ramp_time = tool.motion.ramp_time;
