@@ -239,6 +239,8 @@ const std::vector<Covered>& covered() {
   // (the same kernels, contacts, tools and probes).
   static const std::vector<Covered> c = {
       {"hemisphere/drape.toml", "hemisphere/ci/drape.toml"},
+      // The same with a speed profile for the punch (tests/fem/test_tool_velocity_curve.cpp).
+      {"hemisphere/drape_slow_start.toml", "hemisphere/ci/drape.toml"},
       {"fabrics/biax_0_90_chain/hemisphere_ci.toml", "hemisphere/ci/drape.toml"},
       {"fabrics/biax_0_90_chain/bias_extension.toml", "drape/bias_extension_positive.toml"},
       {"fabrics/biax_0_90_chain/picture_frame.toml", "drape/picture_frame_positive.toml"},
